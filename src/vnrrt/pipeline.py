@@ -1,0 +1,53 @@
+"""Entry points of the DVC stages: each takes the composed parameters (``params.yaml``),
+picks and validates the sections it needs, and calls one computation.
+
+Paths come from the ``paths`` config group only. Stage scripts under ``stages/`` are thin
+wrappers around these functions.
+"""
+
+from __future__ import annotations
+
+import logging
+
+from omegaconf import DictConfig
+
+from vnrrt.config import DataConfig, LabelsConfig, ScaleConfig, section
+from vnrrt.data.build import build_named_maps, build_shard
+from vnrrt.data.manifest import build_manifest, write_json
+from vnrrt.data.shards import shard_file
+
+log = logging.getLogger(__name__)
+
+
+def run_shard(cfg: DictConfig, shard_id: int) -> dict:
+    """Stage ``shard@<id>``: generate and label one shard into ``paths.shards``."""
+    scale = section(cfg, "scale", ScaleConfig)
+    if shard_id not in scale.shards:
+        log.warning("shard %d is not in scale.shards %s", shard_id, scale.shards)
+    return build_shard(
+        shard_file(cfg.paths.shards, shard_id),
+        shard_id,
+        seed=int(cfg.seed),
+        maps_per_shard=scale.maps_per_shard,
+        data=section(cfg, "data", DataConfig),
+        labels=section(cfg, "labels", LabelsConfig),
+        workers=int(cfg.get("workers", 0)),
+    )
+
+
+def run_named_maps(cfg: DictConfig) -> dict:
+    """Stage ``named_maps``: the five named maps as a shard, and their figure (Fig. 4)."""
+    from vnrrt import viz  # matplotlib only where figures are drawn
+
+    data = section(cfg, "data", DataConfig)
+    counts = build_named_maps(cfg.paths.named_maps, data.size, section(cfg, "labels", LabelsConfig))
+    viz.save_named_maps(cfg.paths.named_maps, f"{cfg.paths.figures}/named_maps.png")
+    return counts
+
+
+def run_manifest(cfg: DictConfig) -> dict:
+    """Stage ``manifest``: checksums and counts of all shards, and the data metrics."""
+    scale = section(cfg, "scale", ScaleConfig)
+    summary = build_manifest(cfg.paths.shards, scale.shards, cfg.paths.manifest)
+    write_json(f"{cfg.paths.metrics}/data.json", summary)
+    return summary

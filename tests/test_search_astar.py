@@ -1,0 +1,141 @@
+"""A* and distance fields against an independent shortest-path reference (scipy csgraph)."""
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import dijkstra
+
+from vnrrt.grid import GridError
+from vnrrt.search import NoPathError, astar, descend, distance_field, move_masks, path_length
+
+
+def reference_graph(grid: np.ndarray):
+    """The 8-connected, no-corner-cutting graph built independently with numpy: node
+    ``y * W + x`` for every cell, edges only between free cells."""
+    h, w = grid.shape
+    free = grid == 0
+    rows, cols, costs = [], [], []
+    for dx, dy in [(1, 0), (0, 1), (1, 1), (-1, 1)]:
+        y0, y1 = 0, h - dy
+        x0, x1 = max(0, -dx), w - max(0, dx)
+        ys, xs = np.mgrid[y0:y1, x0:x1]
+        ok = free[ys, xs] & free[ys + dy, xs + dx]
+        if dx and dy:  # both orthogonal neighbours must be free
+            ok &= free[ys, xs + dx] & free[ys + dy, xs]
+        a, b = (ys * w + xs)[ok], ((ys + dy) * w + xs + dx)[ok]
+        rows += [a, b]
+        cols += [b, a]
+        costs += [np.full(len(a), math.hypot(dx, dy))] * 2
+    n = h * w
+    return coo_matrix((np.concatenate(costs), (np.concatenate(rows), np.concatenate(cols))), (n, n))
+
+
+def assert_valid_path(grid, path, start, goal):
+    path = np.asarray(path)
+    assert path[0].tolist() == list(start) and path[-1].tolist() == list(goal)
+    assert np.all(grid[path[:, 1], path[:, 0]] == 0), "path leaves free space"
+    steps = np.diff(path, axis=0)
+    assert np.all(np.abs(steps).max(axis=1) == 1), "path is not 8-connected"
+    for (x, y), (dx, dy) in zip(path[:-1], steps):
+        if dx and dy:
+            assert grid[y, x + dx] == 0 and grid[y + dy, x] == 0, "diagonal cuts a corner"
+
+
+grids = st.tuples(
+    st.integers(0, 10**6), st.integers(5, 30), st.integers(5, 30), st.floats(0.0, 0.45)
+)
+
+
+@given(grids, st.data())
+def test_astar_length_equals_reference(params, data):
+    seed, h, w, density = params
+    rng = np.random.default_rng(seed)
+    grid = (rng.random((h, w)) < density).astype(np.uint8)
+    free = np.argwhere(grid == 0)
+    if len(free) < 2:
+        return
+    i, j = data.draw(st.lists(st.integers(0, len(free) - 1), min_size=2, max_size=2))
+    start, goal = (int(free[i][1]), int(free[i][0])), (int(free[j][1]), int(free[j][0]))
+    ref = dijkstra(reference_graph(grid), indices=start[1] * w + start[0])[goal[1] * w + goal[0]]
+    if not np.isfinite(ref):
+        with pytest.raises(NoPathError):
+            astar(grid, start, goal)
+        return
+    path, length = astar(grid, start, goal)
+    assert length == pytest.approx(ref, abs=1e-9)
+    assert path_length(path) == pytest.approx(length, abs=1e-9)
+    assert_valid_path(grid, path, start, goal)
+
+
+@given(st.integers(0, 10**6), st.floats(0.0, 0.4))
+def test_distance_field_equals_reference_and_descends_optimally(seed, density):
+    rng = np.random.default_rng(seed)
+    grid = (rng.random((20, 26)) < density).astype(np.uint8)
+    free = np.argwhere(grid == 0)
+    if len(free) < 2:
+        return
+    gy, gx = free[0]
+    dist = distance_field(move_masks(grid), (gx, gy))
+    ref = dijkstra(reference_graph(grid), indices=gy * 26 + gx).reshape(20, 26)
+    np.testing.assert_allclose(dist, ref, atol=1e-9)
+    for sy, sx in free[1:6]:
+        if np.isfinite(ref[sy, sx]):
+            path = np.cumsum(
+                np.vstack([[sx, sy], _moves(descend(move_masks(grid), dist, (sx, sy), (gx, gy)))]),
+                axis=0,
+            )
+            assert path_length(path) == pytest.approx(ref[sy, sx], abs=1e-9)
+            assert_valid_path(grid, path, (sx, sy), (gx, gy))
+
+
+def _moves(codes):
+    from vnrrt.grid import MOVES
+
+    return MOVES[np.asarray(codes, dtype=np.int64)].reshape(-1, 2)
+
+
+def test_distance_field_with_targets_is_exact_on_targets():
+    rng = np.random.default_rng(3)
+    grid = (rng.random((60, 60)) < 0.25).astype(np.uint8)
+    free = np.argwhere(grid == 0)
+    goal = free[0][::-1]
+    targets = free[[5, 17, 40]][:, ::-1]
+    full = distance_field(move_masks(grid), goal)
+    early = distance_field(move_masks(grid), goal, targets)
+    for x, y in targets:
+        assert early[y, x] == full[y, x]
+    assert np.isinf(early).sum() >= np.isinf(full).sum()
+
+
+def test_no_corner_cutting_and_known_length():
+    grid = np.zeros((3, 3), np.uint8)
+    grid[0, 1] = 1  # cell (x=1, y=0): the diagonal (0,0) -> (1,1) would cut its corner
+    path, length = astar(grid, (0, 0), (1, 1))
+    assert length == pytest.approx(2.0)  # two straight moves instead of sqrt(2)
+    assert_valid_path(grid, path, (0, 0), (1, 1))
+    open_path, open_len = astar(np.zeros((3, 3), np.uint8), (0, 0), (2, 2))
+    assert open_len == pytest.approx(2 * math.sqrt(2)) and len(open_path) == 3
+
+
+def test_straight_line_is_a_straight_path():
+    path, length = astar(np.zeros((10, 40), np.uint8), (2, 5), (37, 5))
+    assert length == 35 and np.all(path[:, 1] == 5)
+
+
+def test_bad_input_errors_name_the_problem():
+    grid = np.zeros((10, 10), np.uint8)
+    grid[:, 5] = 1
+    with pytest.raises(NoPathError, match="no path"):
+        astar(grid, (0, 0), (9, 9))
+    with pytest.raises(GridError, match="start .* obstacle"):
+        astar(grid, (5, 3), (9, 9))
+    with pytest.raises(GridError, match="goal .* outside"):
+        astar(grid, (0, 0), (10, 3))
+    with pytest.raises(GridError, match="2-D"):
+        astar(np.zeros((4, 4, 1), np.uint8), (0, 0), (1, 1))
+    with pytest.raises(GridError, match="dtype"):
+        astar(grid.astype(float), (0, 0), (1, 1))
