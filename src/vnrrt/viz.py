@@ -1,88 +1,119 @@
-"""Every figure of vnrrt (matplotlib, Agg; no pyplot global state).
+"""Every figure of the project (matplotlib, Agg backend). Nothing else imports matplotlib.
 
-Coordinates follow :mod:`vnrrt.grid`: images are drawn with ``origin='upper'`` and
-``extent=(0, W, H, 0)`` so that a continuous point ``(x, y)`` is plotted at ``(x, y)``
-and cell ``(x, y)`` covers ``[x, x+1) x [y, y+1)``.
+Coordinates as in :mod:`vnrrt.grid`: images are drawn with ``extent=(0, W, H, 0)`` so a
+continuous point (x, y) is plotted at x right, y down, and a cell (x, y) at its centre
+(x + 0.5, y + 0.5).
 """
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import matplotlib
 
 matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+import numpy as np
 
-import numpy as np  # noqa: E402
-from matplotlib.axes import Axes  # noqa: E402
-from matplotlib.collections import LineCollection  # noqa: E402
-from matplotlib.figure import Figure  # noqa: E402
+# --- maps and datasets ---------------------------------------------------------------
 
 
-def draw_grid(ax: Axes, grid: np.ndarray) -> None:
-    """Occupancy ``(H, W)`` (nonzero = obstacle) in black on white, in pixel coordinates."""
+def plot_floor_map(ax, grid, path=None, vertices=None, start=None, goal=None, title=""):
+    """Draw an ``(H, W)`` occupancy grid (obstacles black) on ``ax`` with an optional
+    optimal path ``(T, 2)`` and vertices ``(K, 2)`` (cells x, y, drawn at cell centres),
+    the start as a green star and the goal as a red cross (the paper's Fig. 4 style)."""
     h, w = grid.shape
-    ax.imshow(np.asarray(grid) != 0, cmap="gray_r", vmin=0, vmax=1.6, extent=(0, w, h, 0),
-              interpolation="nearest")  # fmt: skip
+    ax.imshow(np.asarray(grid) != 0, cmap="gray_r", extent=(0, w, h, 0), interpolation="nearest")
+    if path is not None:
+        c = np.asarray(path) + 0.5
+        ax.plot(c[:, 0], c[:, 1], "-", color="tab:blue", lw=1.2, label="optimal path")
+    if vertices is not None:
+        c = np.asarray(vertices) + 0.5
+        ax.plot(c[:, 0], c[:, 1], "o", color="tab:orange", ms=3.5, label="vertices")
+    if start is not None:
+        ax.plot(start[0] + 0.5, start[1] + 0.5, "*", color="tab:green", ms=12)
+    if goal is not None:
+        ax.plot(goal[0] + 0.5, goal[1] + 0.5, "x", color="tab:red", ms=10, mew=2.5)
     ax.set_xlim(0, w)
     ax.set_ylim(h, 0)
-    ax.set_aspect("equal")
+    ax.set_xticks([])
+    ax.set_yticks([])
+    ax.set_title(title, fontsize=9)
 
 
-def draw_heatmap(ax: Axes, heatmap: np.ndarray, alpha: float = 0.55) -> None:
-    """Sampling heatmap ``(H, W)`` overlaid in a warm colormap (zeros transparent)."""
-    h, w = heatmap.shape
-    hm = np.ma.masked_less_equal(np.asarray(heatmap, dtype=float), 0.0)
-    ax.imshow(hm, cmap="autumn_r", alpha=alpha, extent=(0, w, h, 0), interpolation="nearest")
+def save_named_maps(shard_path, out_png) -> None:
+    """Fig. 4: the five named maps of a named-maps shard with optimal paths and vertices."""
+    from vnrrt.data.reader import Shard
 
-
-def draw_tree(ax: Axes, points: np.ndarray, parents: np.ndarray, color: str = "tab:blue") -> None:
-    """Tree edges: ``points`` ``(N, 2)`` (x, y), ``parents`` ``(N,)`` (-1 for the root)."""
-    child = np.flatnonzero(parents >= 0)
-    segs = np.stack([points[parents[child]], points[child]], axis=1)
-    ax.add_collection(LineCollection(segs, colors=color, linewidths=0.4, alpha=0.6))
-
-
-def draw_path(ax: Axes, path: np.ndarray, start, goal, color: str = "red") -> None:
-    """Polyline ``path`` ``(K, 2)`` (x, y) with start (green) and goal (blue) markers."""
-    if len(path):
-        ax.plot(path[:, 0], path[:, 1], color=color, linewidth=1.8)
-    ax.plot(*start, "o", color="limegreen", markersize=7, markeredgecolor="black")
-    ax.plot(*goal, "*", color="deepskyblue", markersize=11, markeredgecolor="black")
-
-
-def plan_figure(grid, result, start, goal, heatmap=None, title: str | None = None) -> Figure:
-    """Map, heatmap (if any), tree (if the result kept it) and path of one planner result."""
-    fig = Figure(figsize=(6, 6), dpi=120)
-    ax = fig.add_subplot()
-    draw_grid(ax, grid)
-    if heatmap is not None:
-        draw_heatmap(ax, heatmap)
-    if result.tree_points is not None:
-        draw_tree(ax, result.tree_points, result.tree_parents)
-    draw_path(ax, result.path, start, goal)
-    ax.set_title(title or f"{result.planner}: cost {result.cost:.1f} px, {result.iterations} it")
+    shard = Shard(shard_path)
+    names = shard.meta.get("names", [str(i) for i in range(shard.n_maps)])
+    fig, axes = plt.subplots(1, shard.n_instances, figsize=(3.2 * shard.n_instances, 3.4))
+    for i, ax in enumerate(np.atleast_1d(axes)):
+        inst = shard.instance(i)
+        title = f"Map {i + 1}: {names[inst['map_index']]}\nA* length {inst['length']:.1f}"
+        plot_floor_map(
+            ax, shard.grid(inst["map_index"]), shard.path(i), shard.vertices(i),
+            inst["start"], inst["goal"], title,
+        )  # fmt: skip
     fig.tight_layout()
-    return fig
+    save_figure(fig, out_png)
 
 
-def cost_trace_figure(results, labels=None) -> Figure:
-    """Best cost (px) versus iteration for several results' sparse traces."""
-    fig = Figure(figsize=(6, 4), dpi=120)
-    ax = fig.add_subplot()
+def save_figure(fig, out_png) -> None:
+    """Save ``fig`` as PNG atomically (temp file + rename) and close it."""
+    from pathlib import Path
+
+    from vnrrt.data.shards import atomic_write_bytes
+
+    atomic_write_bytes(
+        Path(out_png), lambda f: fig.savefig(f, format="png", dpi=110, bbox_inches="tight")
+    )
+    plt.close(fig)
+
+
+# --- planners --------------------------------------------------------------------------
+
+
+def plot_plan(ax, grid, result, start, goal, heatmap=None, title=None):
+    """Draw one planner result on ``ax``: the ``(H, W)`` grid, the sampling ``heatmap``
+    ``(H, W)`` (if any, zeros transparent), the tree (if the result kept it, i.e.
+    ``plan(..., keep_tree=True)``), the path ``(K, 2)`` and the continuous start and goal
+    points ``(x, y)`` (drawn where they are, not shifted to cell centres)."""
+    from matplotlib.collections import LineCollection
+
+    h, w = grid.shape
+    ax.imshow(np.asarray(grid) != 0, cmap="gray_r", extent=(0, w, h, 0), interpolation="nearest")
+    if heatmap is not None:
+        hm = np.ma.masked_less_equal(np.asarray(heatmap, dtype=float), 0.0)
+        ax.imshow(hm, cmap="autumn_r", alpha=0.55, extent=(0, w, h, 0), interpolation="nearest")
+    if result.tree_points is not None:
+        pts, par = result.tree_points, result.tree_parents
+        child = np.flatnonzero(par >= 0)
+        segs = np.stack([pts[par[child]], pts[child]], axis=1)
+        ax.add_collection(LineCollection(segs, colors="tab:blue", linewidths=0.4, alpha=0.6))
+    if len(result.path):
+        ax.plot(result.path[:, 0], result.path[:, 1], "-", color="tab:red", lw=1.8)
+    ax.plot(start[0], start[1], "*", color="tab:green", ms=12)
+    ax.plot(goal[0], goal[1], "x", color="tab:red", ms=10, mew=2.5)
+    ax.set_xlim(0, w)
+    ax.set_ylim(h, 0)
+    ax.set_xticks([])
+    ax.set_yticks([])
+    default = f"{result.planner}: cost {result.cost:.1f} px, {result.iterations} iterations"
+    ax.set_title(title or default, fontsize=9)
+
+
+def save_plan(out_png, grid, result, start, goal, heatmap=None, title=None) -> None:
+    """Map, heatmap, tree and path of one planner result (:func:`plot_plan`) as a PNG."""
+    fig, ax = plt.subplots(figsize=(6, 6))
+    plot_plan(ax, grid, result, start, goal, heatmap, title)
+    fig.tight_layout()
+    save_figure(fig, out_png)
+
+
+def plot_cost_traces(ax, results, labels=None):
+    """Best path cost (px) versus iteration from the sparse traces of planner results."""
     for i, r in enumerate(results):
-        label = labels[i] if labels else r.planner
+        label = labels[i] if labels is not None else r.planner
         ax.step(r.trace_iterations, r.trace_costs, where="post", label=label)
     ax.set_xlabel("iteration")
     ax.set_ylabel("best path cost (px)")
-    ax.legend()
-    fig.tight_layout()
-    return fig
-
-
-def save(fig: Figure, path: str | Path) -> Path:
-    """Write ``fig`` to ``path`` (format from the suffix), creating parent folders."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path)
-    return path
+    ax.legend(fontsize=8)
