@@ -66,22 +66,13 @@ def _label_goal(masks, dist, starts, gx, gy, steps, eps):
         parts.append(moves.astype(np.uint8))
         vparts.append(vidx)
         n_moves[i], n_vert[i] = len(moves), len(vidx)
-    return _concat_u8(parts, n_moves), n_moves, _concat_u32(vparts, n_vert), n_vert, True
+    moves_all = _concat(parts, np.empty(n_moves.sum(), np.uint8))
+    return moves_all, n_moves, _concat(vparts, np.empty(n_vert.sum(), np.uint32)), n_vert, True
 
 
 @njit(cache=True)
-def _concat_u8(parts, counts):
-    out = np.empty(counts.sum(), np.uint8)
-    o = 0
-    for p in parts:
-        out[o : o + len(p)] = p
-        o += len(p)
-    return out
-
-
-@njit(cache=True)
-def _concat_u32(parts, counts):
-    out = np.empty(counts.sum(), np.uint32)
+def _concat(parts, out):
+    """Concatenate the 1-D arrays ``parts`` into the preallocated ``out``; return it."""
     o = 0
     for p in parts:
         out[o : o + len(p)] = p
