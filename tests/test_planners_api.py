@@ -1,0 +1,234 @@
+"""plan(): paths, costs, stop rules and determinism against independent references."""
+
+import itertools
+import math
+
+import numpy as np
+import pytest
+
+from vnrrt.grid import GridError
+from vnrrt.planners import (
+    PLANNERS,
+    PlannerConfigError,
+    any_angle_length,
+    astar_length,
+    plan,
+    segment_free,
+)
+from vnrrt.search import NoPathError, astar
+
+START, GOAL = (20.5, 30.5), (180.5, 40.5)
+
+
+def sampled_path_free(grid, path, step=0.01) -> bool:
+    """Independent check: points every ``step`` px along each segment lie in free cells."""
+    for p0, p1 in itertools.pairwise(path):
+        n = int(np.ceil(np.hypot(*(p1 - p0)) / step)) + 1
+        pts = p0 + np.linspace(0.0, 1.0, n)[:, None] * (p1 - p0)
+        cells = np.floor(pts).astype(int)
+        h, w = grid.shape
+        inside = (cells >= 0).all() and (cells[:, 0] < w).all() and (cells[:, 1] < h).all()
+        if not inside or grid[cells[:, 1], cells[:, 0]].any():
+            return False
+    return True
+
+
+def wall_map() -> np.ndarray:
+    """200x200: a vertical wall at x = 98..101 with a 10 px gap at y = 95..104."""
+    g = np.zeros((200, 200), np.uint8)
+    g[:, 98:102] = 1
+    g[95:105, 98:102] = 0
+    return g
+
+
+def heatmap_for(grid, start, goal) -> np.ndarray:
+    """A plausible learned heatmap: high on the A* path's cells, low elsewhere."""
+    cells = np.floor([start, goal]).astype(int)
+    path, _ = astar(grid, cells[0], cells[1])
+    hm = np.full(grid.shape, 0.02)
+    hm[path[:, 1], path[:, 0]] = 0.95
+    return hm
+
+
+@pytest.fixture(scope="module")
+def grid():
+    return wall_map()
+
+
+@pytest.fixture(scope="module")
+def heat(grid):
+    return heatmap_for(grid, START, GOAL)
+
+
+def kwargs_for(planner, heat):
+    if planner == "rrt_star":
+        return {}
+    return {"heatmap": heat, "tau": 0.5 if planner == "m_vnrrt_star" else None}
+
+
+def check_path(grid, r, start, goal):
+    assert r.success and r.stop_reason == "solved"
+    assert np.array_equal(r.path[0], start) and np.array_equal(r.path[-1], goal)
+    assert sampled_path_free(grid, r.path)
+    seg = np.hypot(*np.diff(r.path, axis=0).T).sum()
+    assert r.cost == pytest.approx(seg, rel=1e-12)
+    assert r.cost >= math.dist(start, goal) - 1e-9
+    assert r.trace_costs[-1] == pytest.approx(r.cost, rel=1e-9)
+    assert np.all(np.diff(r.trace_costs) <= 1e-9) and np.all(np.diff(r.trace_iterations) >= 0)
+    assert 0 < r.time_to_first <= r.time_to_stop
+    assert r.first_iteration <= r.iterations and r.tree_size <= r.iterations + 2
+
+
+@pytest.mark.parametrize("planner", PLANNERS)
+def test_initial_solution_is_valid(grid, heat, planner):
+    r = plan(grid, START, GOAL, planner, stop="initial", seed=3, **kwargs_for(planner, heat))
+    check_path(grid, r, START, GOAL)
+    assert r.first_cost == pytest.approx(r.cost)
+
+
+@pytest.mark.parametrize("planner", PLANNERS)
+def test_optimal_within_one_percent_of_astar(grid, heat, planner):
+    r = plan(grid, START, GOAL, planner, stop="optimal", seed=4, **kwargs_for(planner, heat))
+    check_path(grid, r, START, GOAL)
+    ref = astar_length(grid, START, GOAL)
+    assert r.reference_length == pytest.approx(ref)
+    assert r.cost <= 1.01 * ref
+
+
+def test_any_angle_reference_and_milestones(grid):
+    tight = any_angle_length(grid, START, GOAL)
+    loose = astar_length(grid, START, GOAL)
+    assert math.dist(START, GOAL) < tight < loose
+    r = plan(grid, START, GOAL, stop="optimal", reference="any_angle", milestones=(1.01 * loose,))
+    check_path(grid, r, START, GOAL)
+    assert r.cost <= 1.01 * tight
+    (m,) = r.milestones
+    assert m.reached and r.time_to_first <= m.time <= r.time_to_stop
+
+
+def test_random_rectangles_map():
+    rng = np.random.default_rng(0)
+    g = np.zeros((120, 120), np.uint8)
+    for x, y, w, h in rng.integers([0, 0, 5, 5], [110, 110, 25, 25], size=(14, 4)):
+        g[y : y + h, x : x + w] = 1
+    g[:12, :12] = g[-12:, -12:] = 0
+    r = plan(g, (5.5, 5.5), (114.5, 114.5), stop="optimal", seed=1)
+    check_path(g, r, (5.5, 5.5), (114.5, 114.5))
+    assert r.cost <= 1.01 * astar_length(g, (5.5, 5.5), (114.5, 114.5))
+
+
+def test_same_seed_same_result(grid, heat):
+    a = plan(grid, START, GOAL, "vnrrt_star", heatmap=heat, stop="optimal", seed=12)
+    b = plan(grid, START, GOAL, "vnrrt_star", heatmap=heat, stop="optimal", seed=12)
+    c = plan(grid, START, GOAL, "vnrrt_star", heatmap=heat, stop="optimal", seed=13)
+    assert np.array_equal(a.path, b.path) and a.iterations == b.iterations
+    assert np.array_equal(a.trace_costs, b.trace_costs) and a.collision_checks == b.collision_checks
+    assert a.iterations != c.iterations or not np.array_equal(a.path, c.path)
+
+
+def test_tree_edges_are_free(grid):
+    r = plan(grid, START, GOAL, stop="initial", seed=2, keep_tree=True)
+    pts, par = r.tree_points, r.tree_parents
+    assert len(pts) == r.tree_size and par[0] == -1 and (par[1:] >= 0).all()
+    assert all(segment_free(grid, *pts[par[i]], *pts[i]) for i in range(1, len(pts)))
+
+
+def test_budgets_are_failures_not_exceptions(grid):
+    r = plan(grid, START, GOAL, stop="initial", max_iterations=30)
+    assert not r.success and r.stop_reason == "max_iterations" and r.iterations == 30
+    assert r.path.shape == (0, 2) and math.isinf(r.cost) and math.isnan(r.time_to_first)
+    r = plan(grid, START, GOAL, stop="optimal", reference_length=1.0, max_seconds=0.05)
+    assert not r.success and r.stop_reason == "max_seconds" and r.path.shape[1] == 2
+
+
+@pytest.mark.parametrize(
+    "settings",
+    [{"radius_mode": "fixed", "fixed_radius": 15.0}, {"goal_radius": 3.0, "eta": 5.0},
+     {"gamma": 50.0}, {"mix": 1.0}],
+)  # fmt: skip
+def test_config_variants_still_valid(grid, heat, settings):
+    r = plan(grid, START, GOAL, "nrrt_star", heatmap=heat, stop="optimal", seed=5, **settings)
+    check_path(grid, r, START, GOAL)
+    assert r.cost <= 1.01 * astar_length(grid, START, GOAL)
+
+
+def test_direct_line_of_sight_is_immediate(grid):
+    r = plan(grid, (10.5, 10.5), (15.5, 12.5), stop="optimal")
+    assert r.success and r.iterations == 0 and len(r.path) == 2
+    assert r.cost == pytest.approx(math.dist((10.5, 10.5), (15.5, 12.5)))
+
+
+def test_masked_fallback_is_recorded(grid, heat):
+    r = plan(grid, START, GOAL, "m_vnrrt_star", heatmap=heat, tau=5.0, seed=1)
+    assert r.success and r.fallback_uniform
+
+
+@pytest.mark.parametrize(
+    ("args", "kwargs", "error", "match"),
+    [
+        (((99.5, 50.5), GOAL), {}, GridError, "obstacle"),
+        (((-1.0, 50.5), GOAL), {}, GridError, "outside"),
+        ((START, (200.5, 10.5)), {}, GridError, "outside"),
+        (((0.0, 50.5), GOAL), {}, GridError, "border"),
+        (((float("nan"), 1.0), GOAL), {}, GridError, "finite"),
+        ((START, GOAL, "vnrrt_star"), {"heatmap": np.ones((100, 200))}, GridError, "shape"),
+        ((START, GOAL, "vnrrt_star"), {}, ValueError, "needs a heatmap"),
+        ((START, GOAL, "rrt_star"), {"heatmap": np.ones((200, 200))}, ValueError, "no heatmap"),
+        ((START, GOAL, "astar_star"), {}, ValueError, "unknown planner"),
+        ((START, GOAL), {"stop": "best"}, ValueError, "stop rule"),
+        ((START, GOAL), {"eta": -1.0}, PlannerConfigError, "eta"),
+        ((START, GOAL), {"etta": 1.0}, PlannerConfigError, "unknown"),
+    ],
+)
+def test_bad_input_gives_clear_error(grid, args, kwargs, error, match):
+    with pytest.raises(error, match=match):
+        plan(grid, *args, **kwargs)
+
+
+def test_disconnected_optimal_needs_a_path():
+    g = wall_map()
+    g[95:105, 98:102] = 1
+    with pytest.raises(NoPathError):
+        plan(g, START, GOAL, stop="optimal")
+    r = plan(g, START, GOAL, stop="initial", max_iterations=2000)
+    assert not r.success
+
+
+@pytest.mark.parametrize("planner", PLANNERS)
+@pytest.mark.parametrize("seed", range(5))
+def test_optimal_any_angle_many_seeds(grid, heat, planner, seed):
+    kw = kwargs_for(planner, heat)
+    r = plan(grid, START, GOAL, planner, stop="optimal", reference="any_angle", seed=seed, **kw)
+    check_path(grid, r, START, GOAL)
+    assert r.cost <= 1.01 * any_angle_length(grid, START, GOAL)
+
+
+def shapes_map(seed: int) -> tuple[np.ndarray, tuple, tuple]:
+    """200x200 with random rectangles and discs; endpoints in opposite free corners."""
+    rng = np.random.default_rng(seed)
+    g = np.zeros((200, 200), np.uint8)
+    yy, xx = np.mgrid[:200, :200]
+    for x, y, a, b in rng.integers([0, 0, 8, 8], [200, 200, 40, 40], size=(14, 4)):
+        if a % 2:
+            g[y : y + b, x : x + a] = 1
+        else:
+            g[(xx - x) ** 2 + (yy - y) ** 2 <= (a // 2) ** 2] = 1
+    g[:15, :15] = g[-15:, -15:] = 0
+    return g, (5.5, 5.5), (194.5, 194.5)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("planner", PLANNERS)
+@pytest.mark.parametrize("seed", range(30))
+def test_random_maps_all_planners(planner, seed):
+    g, s, e = shapes_map(seed)
+    try:
+        tight = any_angle_length(g, s, e)
+    except NoPathError:
+        pytest.skip("corners not connected on this map")
+    kw = kwargs_for(planner, heatmap_for(g, s, e))
+    first = plan(g, s, e, planner, seed=seed, **kw)
+    check_path(g, first, s, e)
+    best = plan(g, s, e, planner, stop="optimal", reference="any_angle", seed=seed, **kw)
+    check_path(g, best, s, e)
+    assert best.cost <= 1.01 * tight <= 1.01 * astar_length(g, s, e)

@@ -1,0 +1,103 @@
+"""Exact segment-versus-grid test against independent references (closed obstacle squares)."""
+
+import numpy as np
+import pytest
+
+from vnrrt.planners import path_free, point_free, segment_free
+
+
+def touches_box(p0, p1, lo, hi) -> bool:
+    """Liang-Barsky: does segment p0-p1 meet the closed box [lo, hi] (2-vectors)?"""
+    t0, t1 = 0.0, 1.0
+    d = p1 - p0
+    for a in range(2):
+        if d[a] == 0.0:
+            if not lo[a] <= p0[a] <= hi[a]:
+                return False
+            continue
+        ta, tb = sorted(((lo[a] - p0[a]) / d[a], (hi[a] - p0[a]) / d[a]))
+        t0, t1 = max(t0, ta), min(t1, tb)
+        if t0 > t1:
+            return False
+    return True
+
+
+def reference_free(grid, p0, p1) -> bool:
+    """Brute force: no closed obstacle square (and no map border) touched."""
+    h, w = grid.shape
+    pts = np.array([p0, p1])
+    if pts[:, 0].min() <= 0 or pts[:, 1].min() <= 0 or pts[:, 0].max() >= w:
+        return False
+    if pts[:, 1].max() >= h:
+        return False
+    for y, x in np.argwhere(grid):
+        if touches_box(np.asarray(p0), np.asarray(p1), np.array([x, y]), np.array([x + 1, y + 1])):
+            return False
+    return True
+
+
+def sampled_free(grid, p0, p1, step=0.005) -> bool:
+    """Finely sampled point checks (open cells): weaker than the exact rule."""
+    n = int(np.ceil(np.hypot(*(np.subtract(p1, p0))) / step)) + 1
+    t = np.linspace(0.0, 1.0, n)[:, None]
+    cells = np.floor(np.asarray(p0) + t * np.subtract(p1, p0)).astype(int)
+    return not grid[cells[:, 1], cells[:, 0]].any()
+
+
+@pytest.fixture(scope="module")
+def grid():
+    rng = np.random.default_rng(7)
+    return (rng.random((12, 14)) < 0.25).astype(np.uint8)
+
+
+def test_corner_touch_counts_both_diagonal_cells():
+    g = np.zeros((4, 4), np.uint8)
+    g[1, 2] = 1  # cell (2, 1); its corner (2, 2) lies on the diagonal below
+    assert not segment_free(g, 1.5, 1.5, 2.5, 2.5)  # passes exactly through corner (2, 2)
+    assert not segment_free(g, 2.5, 2.5, 1.5, 1.5)  # same segment reversed
+    assert segment_free(g, 1.5, 1.6, 2.4, 2.5)  # misses the corner by 0.07 px
+    g = np.zeros((4, 4), np.uint8)
+    g[2, 1] = 1  # the other diagonal neighbour, cell (1, 2)
+    assert not segment_free(g, 1.5, 1.5, 2.5, 2.5)
+
+
+def test_edges_and_border_are_closed():
+    g = np.zeros((5, 5), np.uint8)
+    g[:, 1] = 1  # column x = 1 covers [1, 2]
+    assert not segment_free(g, 2.0, 0.5, 2.0, 4.5)  # runs along its right edge
+    assert segment_free(g, 2.0 + 1e-6, 0.5, 2.0 + 1e-6, 4.5)
+    assert not segment_free(g, 3.5, 0.0, 3.5, 2.0)  # touches the top border y = 0
+    assert not point_free(g, (2.0, 3.0)) and point_free(g, (2.5, 3.0))
+
+
+@pytest.mark.parametrize("lattice", [True, False])
+def test_matches_brute_force_reference(grid, lattice):
+    rng = np.random.default_rng(11 + lattice)
+    h, w = grid.shape
+    agree, blocked = 0, 0
+    for _ in range(1500):
+        p = rng.uniform(0.2, [w - 0.2, h - 0.2, w - 0.2, h - 0.2])
+        if lattice:  # endpoints on the half-pixel lattice hit corners and edges exactly
+            p = np.clip(np.round(p * 2) / 2, 0.5, [w - 0.5, h - 0.5, w - 0.5, h - 0.5])
+        got = segment_free(grid, *p)
+        assert got == reference_free(grid, p[:2], p[2:]), p
+        agree += 1
+        blocked += not got
+    assert agree == 1500 and 200 < blocked < 1400  # both outcomes well represented
+
+
+def test_never_weaker_than_sampling(grid):
+    rng = np.random.default_rng(3)
+    h, w = grid.shape
+    for _ in range(500):
+        p = rng.uniform(0.1, [w - 0.1, h - 0.1, w - 0.1, h - 0.1])
+        if segment_free(grid, *p):
+            assert sampled_free(grid, p[:2], p[2:])
+
+
+def test_path_free_checks_every_segment():
+    g = np.zeros((6, 6), np.uint8)
+    g[3, 3] = 1
+    ok = np.array([[0.5, 0.5], [5.5, 0.5], [5.5, 5.5]])
+    bad = np.array([[0.5, 0.5], [0.5, 5.5], [5.5, 0.5]])  # last leg crosses (3, 3)'s corner
+    assert path_free(g, ok) and not path_free(g, bad)
