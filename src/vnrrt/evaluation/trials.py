@@ -1,0 +1,110 @@
+"""Planner trials of the paper's protocol: every planner configuration, on every evaluation
+instance, for N trials per stop rule, over all cores; one table row per trial.
+
+An :class:`EvalInstance` carries its own grid, continuous start/goal (cell centres), A*
+reference length and the heatmaps the learned planners sample from (``'path'``: the
+NRRT* network, ``'vertex'``: VertexNet), so jobs are self-contained and picklable.
+Seeds derive from (global seed, instance index, planner configuration, stop, trial) only:
+the table does not depend on the number of workers or the order of jobs.
+"""
+
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+
+from vnrrt.evaluation.report import TRIAL_COLUMNS, planner_key
+from vnrrt.parallel import parallel_map
+from vnrrt.planners import plan, warmup
+
+
+@dataclass(frozen=True)
+class PlannerSpec:
+    """One evaluated configuration: a planner, its mask threshold and heatmap source."""
+
+    planner: str
+    tau: float | None = None
+    heatmap: str | None = None  # key into EvalInstance.heatmaps; None = uniform
+
+    @property
+    def key(self) -> str:
+        return planner_key(self.planner, self.tau)
+
+
+@dataclass(frozen=True)
+class EvalInstance:
+    """One planning problem: ``grid`` (H, W) uint8, ``start``/``goal`` (x, y) pixels,
+    ``reference_length`` (A* optimum, px), ``heatmaps`` name -> (H, W) float array."""
+
+    map_set: str  # map_1 .. map_5 | random
+    map: str
+    grid: np.ndarray
+    start: tuple[float, float]
+    goal: tuple[float, float]
+    reference_length: float
+    heatmaps: dict[str, np.ndarray] = field(default_factory=dict)
+
+
+def trial_seed(seed: int, instance: int, spec: PlannerSpec, stop: str, trial: int) -> int:
+    """A 63-bit seed from (global seed, instance, planner configuration, stop, trial)."""
+    key = [ord(c) for c in f"{spec.key}/{stop}"]
+    ss = np.random.SeedSequence([seed, instance, trial, *key])
+    return int(ss.generate_state(1, np.uint64)[0] >> np.uint64(1))
+
+
+def _job(args, seed: int, overrides: dict) -> list[dict]:
+    """Run the trials of one (instance, spec, stop); returns table rows."""
+    index, inst, spec, stop, n_trials = args
+    warmup()
+    heatmap = None if spec.heatmap is None else inst.heatmaps[spec.heatmap]
+    rows = []
+    for trial in range(n_trials):
+        r = plan(
+            inst.grid, inst.start, inst.goal, spec.planner, heatmap=heatmap, tau=spec.tau,
+            stop=stop, reference_length=inst.reference_length,
+            seed=trial_seed(seed, index, spec, stop, trial), **overrides,
+        )  # fmt: skip
+        rows.append({
+            "planner": spec.planner, "tau": np.nan if spec.tau is None else spec.tau,
+            "map_set": inst.map_set, "map": inst.map, "trial": trial, "stop": stop,
+            "success": r.success, "cost": r.cost, "iterations": r.iterations,
+            "tree_size": r.tree_size, "collision_checks": r.collision_checks,
+            "time_to_first": r.time_to_first, "time_to_stop": r.time_to_stop,
+            "stop_reason": r.stop_reason, "reference_length": inst.reference_length,
+            "fallback_uniform": r.fallback_uniform,
+        })  # fmt: skip
+    return rows
+
+
+def run_trials(
+    instances: list[EvalInstance],
+    specs: list[PlannerSpec],
+    trials: dict[tuple[str, str], int],
+    seed: int = 0,
+    workers: int = 0,
+    overrides: dict | None = None,
+) -> pd.DataFrame:
+    """All trials as a table (columns :data:`TRIAL_COLUMNS` and a few more).
+
+    ``trials[(map_set_kind, stop)]`` is the number of trials per instance, with
+    ``map_set_kind`` ``'named'`` (map_1 .. map_5) or ``'random'``. ``overrides`` are
+    planner settings (budgets, eta, ...) passed to :func:`vnrrt.planners.plan`.
+    A trial that exhausts a budget is a row with ``success=False``.
+    """
+    jobs = []
+    for i, inst in enumerate(instances):
+        kind = "random" if inst.map_set == "random" else "named"
+        for spec in specs:
+            if spec.heatmap is not None and spec.heatmap not in inst.heatmaps:
+                raise KeyError(f"instance {inst.map} has no '{spec.heatmap}' heatmap")
+            for stop in ("initial", "optimal"):
+                n = trials.get((kind, stop), 0)
+                if n > 0:
+                    jobs.append((i, inst, spec, stop, n))
+    job = functools.partial(_job, seed=seed, overrides=dict(overrides or {}))
+    parts = parallel_map(job, jobs, workers, "trials")
+    table = pd.DataFrame([row for rows in parts for row in rows])
+    return table.reindex(columns=[*TRIAL_COLUMNS, *[c for c in table if c not in TRIAL_COLUMNS]])
