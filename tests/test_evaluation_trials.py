@@ -56,3 +56,14 @@ def test_missing_heatmap_is_a_clear_error():
     bare = EvalInstance(inst.map_set, inst.map, inst.grid, inst.start, inst.goal, 1.0)
     with pytest.raises(KeyError, match="no 'path' heatmap"):
         run_trials([bare], SPECS, {("named", "initial"): 1})
+
+
+def test_optimal_runs_record_monotone_convergence_times():
+    from vnrrt.evaluation.trials import CONVERGENCE_FACTORS, convergence_column
+
+    table = run_trials([wall_instance()], SPECS[:2], {("named", "optimal"): 2})
+    cols = [convergence_column(f) for f in CONVERGENCE_FACTORS]
+    times = table[cols + ["time_to_stop"]].to_numpy()
+    assert np.all(np.isfinite(times))
+    assert np.all(np.diff(times, axis=1) >= 0)  # looser bounds are reached first
+    assert np.all(table["time_to_first"] <= times[:, 0])

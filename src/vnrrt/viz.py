@@ -117,3 +117,62 @@ def plot_cost_traces(ax, results, labels=None):
     ax.set_xlabel("iteration")
     ax.set_ylabel("best path cost (px)")
     ax.legend(fontsize=8)
+
+
+# --- evaluation ------------------------------------------------------------------------
+
+
+def save_sampling_distributions(out_png, grid, path, vertices, path_heatmap, vertex_heatmap):
+    """Fig. 3: (a) optimal path, (b) its vertices, (c) the NRRT* (path network) and (d) the
+    VNRRT* (VertexNet) sampling distributions for one instance. ``grid`` (H, W); ``path``
+    (T, 2) and ``vertices`` (K, 2) cells (x, y); heatmaps (H, W) probabilities."""
+    fig, axes = plt.subplots(1, 4, figsize=(13, 3.6))
+    plot_floor_map(axes[0], grid, path=path, start=path[0], goal=path[-1], title="(a) optimal path")
+    plot_floor_map(axes[1], grid, vertices=vertices, start=path[0], goal=path[-1],
+                   title="(b) vertices of the optimal path")  # fmt: skip
+    h, w = grid.shape
+    for ax, heat, title in ((axes[2], path_heatmap, "(c) NRRT* (path network)"),
+                            (axes[3], vertex_heatmap, "(d) VNRRT* (VertexNet)")):  # fmt: skip
+        ax.imshow(np.asarray(grid) != 0, cmap="gray_r", alpha=0.35, extent=(0, w, h, 0))
+        im = ax.imshow(np.asarray(heat, float), cmap="magma_r", alpha=0.85, vmin=0, vmax=1,
+                       extent=(0, w, h, 0), interpolation="nearest")  # fmt: skip
+        ax.set_xticks([])
+        ax.set_yticks([])
+        ax.set_title(title, fontsize=9)
+    fig.colorbar(im, ax=axes[2:], shrink=0.8, label="predicted probability")
+    save_figure(fig, out_png)
+
+
+def save_improvements(out_png, improvements, title):
+    """Fig. 5: improvement over RRT* (``baseline / planner - 1``, in %) per map set.
+
+    ``improvements``: ``{planner_key: {map_set: (value, ci_low, ci_high)}}``."""
+    keys = list(improvements)
+    sets = sorted({m for v in improvements.values() for m in v})
+    fig, ax = plt.subplots(figsize=(1.6 * len(sets) + 3, 3.8))
+    width = 0.8 / max(len(keys), 1)
+    for i, key in enumerate(keys):
+        vals = np.array([improvements[key].get(m, (np.nan,) * 3) for m in sets]) * 100
+        xs = np.arange(len(sets)) + (i - (len(keys) - 1) / 2) * width
+        err = np.abs(vals[:, 1:].T - vals[:, 0])
+        ax.bar(xs, vals[:, 0], width, yerr=err, capsize=2, label=key)
+    ax.axhline(0, color="black", lw=0.8)
+    ax.set_xticks(np.arange(len(sets)), sets)
+    ax.set_ylabel("improvement over RRT* (%)")
+    ax.set_title(title, fontsize=10)
+    ax.legend(fontsize=7, ncol=2)
+    save_figure(fig, out_png)
+
+
+def save_convergence(out_png, curves, title):
+    """Cost versus time: ``curves`` ``{planner_key: (times (F,), factors (F,))}``, median
+    time (s) at which the best cost first fell below ``factor`` x the A* length."""
+    fig, ax = plt.subplots(figsize=(6, 4))
+    for key, (times, factors) in curves.items():
+        ax.plot(times, factors, "o-", ms=3, label=key)
+    ax.set_xscale("log")
+    ax.set_xlabel("median time (s)")
+    ax.set_ylabel("best cost / A* length")
+    ax.set_title(title, fontsize=10)
+    ax.legend(fontsize=7)
+    save_figure(fig, out_png)

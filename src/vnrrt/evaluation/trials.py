@@ -20,6 +20,15 @@ from vnrrt.evaluation.report import TRIAL_COLUMNS, planner_key
 from vnrrt.parallel import parallel_map
 from vnrrt.planners import plan, warmup
 
+# Cost bounds (x reference length) whose first-reach time is recorded in optimal runs:
+# the convergence curve (cost versus time) of every trial.
+CONVERGENCE_FACTORS = (2.0, 1.5, 1.2, 1.1, 1.05, 1.02)
+
+
+def convergence_column(factor: float) -> str:
+    """Column of the time (s) to reach ``factor`` x reference length, e.g. ``t_1.05x``."""
+    return f"t_{factor:g}x"
+
 
 @dataclass(frozen=True)
 class PlannerSpec:
@@ -60,12 +69,14 @@ def _job(args, seed: int, overrides: dict) -> list[dict]:
     index, inst, spec, stop, n_trials = args
     warmup()
     heatmap = None if spec.heatmap is None else inst.heatmaps[spec.heatmap]
+    factors = CONVERGENCE_FACTORS if stop == "optimal" else ()
     rows = []
     for trial in range(n_trials):
         r = plan(
             inst.grid, inst.start, inst.goal, spec.planner, heatmap=heatmap, tau=spec.tau,
             stop=stop, reference_length=inst.reference_length,
-            seed=trial_seed(seed, index, spec, stop, trial), **overrides,
+            seed=trial_seed(seed, index, spec, stop, trial),
+            milestones=tuple(f * inst.reference_length for f in factors), **overrides,
         )  # fmt: skip
         rows.append({
             "planner": spec.planner, "tau": np.nan if spec.tau is None else spec.tau,
@@ -75,6 +86,7 @@ def _job(args, seed: int, overrides: dict) -> list[dict]:
             "time_to_first": r.time_to_first, "time_to_stop": r.time_to_stop,
             "stop_reason": r.stop_reason, "reference_length": inst.reference_length,
             "fallback_uniform": r.fallback_uniform,
+            **{convergence_column(f): m.time for f, m in zip(factors, r.milestones)},
         })  # fmt: skip
     return rows
 
