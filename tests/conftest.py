@@ -27,3 +27,33 @@ def random_grid(seed: int, h: int = 24, w: int = 24, density: float = 0.3) -> np
     """A small random occupancy grid (uint8, 1 = obstacle) for property tests."""
     rng = np.random.default_rng(seed)
     return (rng.random((h, w)) < density).astype(np.uint8)
+
+
+@pytest.fixture(scope="session")
+def small_data(tmp_path_factory) -> Path:
+    """Smoke-scale shards, manifest and named maps on 64x64 maps (training tests)."""
+    from tests.train_helpers import SMALL, build_data
+
+    return build_data(tmp_path_factory.mktemp("small_data"), SMALL)
+
+
+@pytest.fixture(scope="session")
+def smoke_data(tmp_path_factory) -> Path:
+    """The real smoke-scale data (200x200 maps) in a tmp dir."""
+    from tests.train_helpers import build_data
+
+    return build_data(tmp_path_factory.mktemp("smoke_data"), ["scale=smoke"])
+
+
+@pytest.fixture(scope="session")
+def trained(small_data, tmp_path_factory) -> Path:
+    """Outputs (``models/vertexnet.ckpt``, ``models/nrrtnet.ckpt``, metrics) of two training
+    steps of each network on the 64x64 smoke data."""
+    from tests.train_helpers import QUICK, small_cfg
+    from vnrrt.train import train
+
+    out = tmp_path_factory.mktemp("trained")
+    cfg = small_cfg(small_data, out, *QUICK)
+    for name in ("vertexnet", "nrrtnet"):
+        train(cfg, name)
+    return out

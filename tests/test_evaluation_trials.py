@@ -5,6 +5,7 @@ import pytest
 
 from vnrrt.evaluation.report import TRIAL_COLUMNS
 from vnrrt.evaluation.trials import EvalInstance, PlannerSpec, run_trials, trial_seed
+from vnrrt.planners import PlannerConfig
 from vnrrt.search import astar
 
 
@@ -46,7 +47,7 @@ def test_trials_are_deterministic_and_worker_independent():
 
 def test_a_budget_hit_is_a_failed_row_not_a_crash():
     table = run_trials([wall_instance()], SPECS[:1], {("named", "optimal"): 2},
-                       overrides={"max_iterations": 5})  # fmt: skip
+                       config=PlannerConfig(max_iterations=5))  # fmt: skip
     assert len(table) == 2 and not table["success"].any()
     assert set(table["stop_reason"]) == {"max_iterations"}
 
@@ -63,7 +64,7 @@ def test_optimal_runs_record_monotone_convergence_times():
 
     table = run_trials([wall_instance()], SPECS[:2], {("named", "optimal"): 2})
     cols = [convergence_column(f) for f in CONVERGENCE_FACTORS]
-    times = table[cols + ["time_to_stop"]].to_numpy()
+    times = table[[*cols, "time_to_stop"]].to_numpy()
     assert np.all(np.isfinite(times))
     assert np.all(np.diff(times, axis=1) >= 0)  # looser bounds are reached first
     assert np.all(table["time_to_first"] <= times[:, 0])

@@ -16,7 +16,7 @@ MODELS = sorted(p.stem for p in (CONF / "model").glob("*.yaml"))
 @pytest.mark.parametrize("name", MODELS)
 def test_model_config_instantiates(name: str) -> None:
     with initialize_config_dir(config_dir=str(CONF), version_base="1.3"):
-        cfg = compose("config", overrides=[f"+model={name}"])
+        cfg = compose("config", overrides=[f"model={name}"])
     net, loss = instantiate(cfg.model.net), instantiate(cfg.model.loss)
     assert isinstance(net, VertexNet) and isinstance(loss, FocalLoss)
     assert loss.gamma == 2.0
@@ -29,6 +29,6 @@ def test_model_config_instantiates(name: str) -> None:
 
 def test_paper_config_is_the_paper_network() -> None:
     with initialize_config_dir(config_dir=str(CONF), version_base="1.3"):
-        cfg = compose("config", overrides=["+model=vertexnet"])
+        cfg = compose("config", overrides=["model=vertexnet"])
     assert cfg.model.net.encoder == "resnet34" and cfg.model.net.decoder_width == 1.0
     assert cfg.model.net.freeze_encoder is True and cfg.model.net.weights is None

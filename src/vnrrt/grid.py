@@ -100,3 +100,15 @@ def cell_center(cells: np.ndarray) -> np.ndarray:
 def point_to_cell(points: np.ndarray) -> np.ndarray:
     """Cells ``(N, 2)`` int64 (x, y) containing continuous points ``(N, 2)`` (x, y)."""
     return np.floor(np.asarray(points, dtype=np.float64)).astype(np.int64)
+
+
+def disk(radius: float) -> np.ndarray:
+    """The cells within Euclidean distance ``radius`` (pixels) of a centre cell, as a
+    ``(2k+1, 2k+1)`` bool stencil with ``k = floor(radius)`` and the centre at ``[k, k]``:
+    offset ``(dx, dy)`` is in it when ``dx^2 + dy^2 <= radius^2``. ``radius`` 0 is the centre
+    cell alone. Used for target dilation, start/goal markers and "within r px" metrics."""
+    if not (radius >= 0 and math.isfinite(radius)):
+        raise GridError(f"disk radius must be finite and >= 0, got {radius!r}")
+    k = int(math.floor(radius))
+    d = np.arange(-k, k + 1)
+    return d[None, :] ** 2 + d[:, None] ** 2 <= radius * radius

@@ -51,3 +51,36 @@ def run_manifest(cfg: DictConfig) -> dict:
     summary = build_manifest(cfg.paths.shards, scale.shards, cfg.paths.manifest)
     write_json(f"{cfg.paths.metrics}/data.json", summary)
     return summary
+
+
+def run_train(cfg: DictConfig, network: str) -> dict:
+    """Stage ``train_<network>``: train VertexNet (``vertexnet``) or the NRRT* network
+    (``nrrtnet``) into ``paths.models`` and log the run to MLflow (:mod:`vnrrt.train`)."""
+    from vnrrt import tracking
+
+    tracking.configure(cfg.logger.uri)  # before Lightning (and its MLflow logger) is imported
+    from vnrrt.train import train
+
+    return train(cfg, network)
+
+
+def run_predict(cfg: DictConfig) -> dict:
+    """Stage ``predict``: heatmaps of the trained networks for the evaluation instances
+    (:mod:`vnrrt.predict`), their metrics, and the paper's Fig. 3 on the named maps."""
+    from vnrrt import viz
+    from vnrrt.data.heatmaps import read_heatmaps
+    from vnrrt.data.reader import Shard
+    from vnrrt.predict import predict
+
+    results = predict(cfg)
+    write_json(f"{cfg.paths.metrics}/predict.json", results)
+    named = Shard(cfg.paths.named_maps)
+    ids = named.instances()
+    maps = {name: read_heatmaps(f"{cfg.paths.heatmaps}/{name}.npz")["named"] for name in results}
+    viz.save_heatmaps(
+        f"{cfg.paths.figures}/heatmaps.png",
+        [named.grid(named.instance(i)["map_index"]) for i in ids],
+        [named.path(i) for i in ids], [named.vertices(i) for i in ids], maps,
+        titles=named.meta.get("names"),
+    )  # fmt: skip
+    return results

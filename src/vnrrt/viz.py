@@ -122,27 +122,6 @@ def plot_cost_traces(ax, results, labels=None):
 # --- evaluation ------------------------------------------------------------------------
 
 
-def save_sampling_distributions(out_png, grid, path, vertices, path_heatmap, vertex_heatmap):
-    """Fig. 3: (a) optimal path, (b) its vertices, (c) the NRRT* (path network) and (d) the
-    VNRRT* (VertexNet) sampling distributions for one instance. ``grid`` (H, W); ``path``
-    (T, 2) and ``vertices`` (K, 2) cells (x, y); heatmaps (H, W) probabilities."""
-    fig, axes = plt.subplots(1, 4, figsize=(13, 3.6))
-    plot_floor_map(axes[0], grid, path=path, start=path[0], goal=path[-1], title="(a) optimal path")
-    plot_floor_map(axes[1], grid, vertices=vertices, start=path[0], goal=path[-1],
-                   title="(b) vertices of the optimal path")  # fmt: skip
-    h, w = grid.shape
-    for ax, heat, title in ((axes[2], path_heatmap, "(c) NRRT* (path network)"),
-                            (axes[3], vertex_heatmap, "(d) VNRRT* (VertexNet)")):  # fmt: skip
-        ax.imshow(np.asarray(grid) != 0, cmap="gray_r", alpha=0.35, extent=(0, w, h, 0))
-        im = ax.imshow(np.asarray(heat, float), cmap="magma_r", alpha=0.85, vmin=0, vmax=1,
-                       extent=(0, w, h, 0), interpolation="nearest")  # fmt: skip
-        ax.set_xticks([])
-        ax.set_yticks([])
-        ax.set_title(title, fontsize=9)
-    fig.colorbar(im, ax=axes[2:], shrink=0.8, label="predicted probability")
-    save_figure(fig, out_png)
-
-
 def save_improvements(out_png, improvements, title):
     """Fig. 5: improvement over RRT* (``baseline / planner - 1``, in %) per map set.
 
@@ -160,19 +139,88 @@ def save_improvements(out_png, improvements, title):
     ax.set_xticks(np.arange(len(sets)), sets)
     ax.set_ylabel("improvement over RRT* (%)")
     ax.set_title(title, fontsize=10)
-    ax.legend(fontsize=7, ncol=2)
+    if keys:
+        ax.legend(fontsize=7, ncol=2)
+    else:
+        ax.text(0.5, 0.5, "no trials for this stop rule", ha="center", transform=ax.transAxes)
     save_figure(fig, out_png)
 
 
-def save_convergence(out_png, curves, title):
-    """Cost versus time: ``curves`` ``{planner_key: (times (F,), factors (F,))}``, median
-    time (s) at which the best cost first fell below ``factor`` x the A* length."""
-    fig, ax = plt.subplots(figsize=(6, 4))
-    for key, (times, factors) in curves.items():
-        ax.plot(times, factors, "o-", ms=3, label=key)
-    ax.set_xscale("log")
-    ax.set_xlabel("median time (s)")
-    ax.set_ylabel("best cost / A* length")
-    ax.set_title(title, fontsize=10)
-    ax.legend(fontsize=7)
+def save_convergence_table(out_png, curves):
+    """Cost versus time per map set: ``curves`` a table with columns ``planner``,
+    ``map_set``, ``factor`` (cost bound / A* length; the smallest is the stop rule) and
+    ``median_time`` (s) at which the best cost first fell below that bound."""
+    sets = sorted(set(curves["map_set"]))
+    fig, axes = plt.subplots(1, len(sets), figsize=(3.6 * len(sets), 3.4), squeeze=False)
+    for ax, map_set in zip(axes[0], sets):
+        sub = curves[curves["map_set"] == map_set]
+        for key, rows in sub.groupby("planner"):
+            ax.plot(rows["median_time"], rows["factor"], "o-", ms=3, label=key)
+        ax.set_xscale("log")
+        ax.set_xlabel("median time (s)")
+        ax.set_title(map_set, fontsize=9)
+    axes[0, 0].set_ylabel("best cost / A* length")
+    axes[0, -1].legend(fontsize=7)
+    fig.suptitle("Convergence to the optimal path", fontsize=10)
+    save_figure(fig, out_png)
+
+
+# --- training: predicted heatmaps (the paper's Fig. 3) ---------------------------------
+
+
+def close(fig) -> None:
+    """Release a figure made here (after logging it elsewhere, e.g. to MLflow)."""
+    plt.close(fig)
+
+
+def plot_heatmap(ax, heatmap, title="", vmax=None):
+    """A probability map ``(H, W)`` on ``ax``, dark = high (the paper's Fig. 3 convention),
+    over ``[0, vmax]`` (default: its maximum, so faint maps stay visible)."""
+    h, w = heatmap.shape
+    top = float(vmax if vmax is not None else max(float(np.max(heatmap)), 1e-6))
+    ax.imshow(heatmap, cmap="gray_r", vmin=0.0, vmax=top, extent=(0, w, h, 0),
+              interpolation="nearest")  # fmt: skip
+    ax.set_xticks([])
+    ax.set_yticks([])
+    ax.set_title(title, fontsize=8)
+
+
+def prediction_figure(rgb, target, vertices, probs, titles=None):
+    """Validation figure: one row per instance with the input image ``rgb`` ``(K, H, W, 3)``,
+    the ground truth ``target`` ``(K, H, W)`` (true vertices ``(K, H, W)`` ringed) and the
+    predicted probability map ``probs`` ``(K, H, W)``. Returns the figure (not saved)."""
+    k = len(rgb)
+    fig, axes = plt.subplots(k, 3, figsize=(7.5, 2.6 * k), squeeze=False)
+    for i in range(k):
+        h, w = target[i].shape
+        axes[i, 0].imshow(rgb[i], extent=(0, w, h, 0), interpolation="nearest")
+        axes[i, 0].set_title(titles[i] if titles else "input", fontsize=8)
+        axes[i, 1].imshow(rgb[i], alpha=0.3, extent=(0, w, h, 0), interpolation="nearest")
+        shown = np.ma.masked_equal(np.asarray(target[i], dtype=float), 0.0)
+        axes[i, 1].imshow(shown, cmap="gray_r", vmin=0.0, vmax=1.0, extent=(0, w, h, 0),
+                          interpolation="nearest")  # fmt: skip
+        axes[i, 1].set_title("ground truth", fontsize=8)
+        ys, xs = np.nonzero(vertices[i])
+        axes[i, 1].plot(xs + 0.5, ys + 0.5, "o", mfc="none", mec="tab:orange", ms=6)
+        plot_heatmap(axes[i, 2], probs[i], f"predicted (max {float(np.max(probs[i])):.2f})")
+        for ax in axes[i, :2]:
+            ax.set_xticks([])
+            ax.set_yticks([])
+    fig.tight_layout()
+    return fig
+
+
+def save_heatmaps(out_png, grids, paths, vertices, heatmaps, titles=None) -> None:
+    """Fig. 3 for several maps: per row (one instance) (a) the optimal path ``paths[i]``
+    ``(T, 2)`` on grid ``grids[i]`` ``(H, W)``, (b) its vertices ``(K, 2)`` (cells x, y), then
+    one column per entry of ``heatmaps`` ``{name: (N, H, W)}`` (e.g. NRRT*, VertexNet)."""
+    n, cols = len(grids), 2 + len(heatmaps)
+    fig, axes = plt.subplots(n, cols, figsize=(2.6 * cols, 2.7 * n), squeeze=False)
+    for i in range(n):
+        name = titles[i] if titles else f"map {i + 1}"
+        plot_floor_map(axes[i, 0], grids[i], path=paths[i], title=f"{name}: optimal path")
+        plot_floor_map(axes[i, 1], grids[i], vertices=vertices[i], title="vertices")
+        for j, (label, maps) in enumerate(heatmaps.items()):
+            plot_heatmap(axes[i, 2 + j], np.asarray(maps[i], dtype=float), label)
+    fig.tight_layout()
     save_figure(fig, out_png)

@@ -18,7 +18,10 @@ import pandas as pd
 
 from vnrrt.evaluation.report import TRIAL_COLUMNS, planner_key
 from vnrrt.parallel import parallel_map
-from vnrrt.planners import plan, warmup
+from vnrrt.planners import PlannerConfig, plan, warmup
+
+# Stop rules of the protocol: the paper's two, and the stricter any-angle optimum.
+STOPS = ("initial", "optimal", "optimal_any_angle")
 
 # Cost bounds (x reference length) whose first-reach time is recorded in optimal runs:
 # the convergence curve (cost versus time) of every trial.
@@ -46,7 +49,8 @@ class PlannerSpec:
 @dataclass(frozen=True)
 class EvalInstance:
     """One planning problem: ``grid`` (H, W) uint8, ``start``/``goal`` (x, y) pixels,
-    ``reference_length`` (A* optimum, px), ``heatmaps`` name -> (H, W) float array."""
+    ``reference_length`` (A* optimum, px), ``heatmaps`` name -> (H, W) float array and,
+    for the ``optimal_any_angle`` stop, the any-angle length (px)."""
 
     map_set: str  # map_1 .. map_5 | random
     map: str
@@ -55,6 +59,7 @@ class EvalInstance:
     goal: tuple[float, float]
     reference_length: float
     heatmaps: dict[str, np.ndarray] = field(default_factory=dict)
+    any_angle_length: float | None = None  # the taut A* path's length, for optimal_any_angle
 
 
 def trial_seed(seed: int, instance: int, spec: PlannerSpec, stop: str, trial: int) -> int:
@@ -64,19 +69,20 @@ def trial_seed(seed: int, instance: int, spec: PlannerSpec, stop: str, trial: in
     return int(ss.generate_state(1, np.uint64)[0] >> np.uint64(1))
 
 
-def _job(args, seed: int, overrides: dict) -> list[dict]:
+def _job(args, seed: int, config: PlannerConfig) -> list[dict]:
     """Run the trials of one (instance, spec, stop); returns table rows."""
     index, inst, spec, stop, n_trials = args
     warmup()
     heatmap = None if spec.heatmap is None else inst.heatmaps[spec.heatmap]
     factors = CONVERGENCE_FACTORS if stop == "optimal" else ()
+    ref = inst.any_angle_length if stop == "optimal_any_angle" else inst.reference_length
     rows = []
     for trial in range(n_trials):
         r = plan(
             inst.grid, inst.start, inst.goal, spec.planner, heatmap=heatmap, tau=spec.tau,
-            stop=stop, reference_length=inst.reference_length,
+            stop="initial" if stop == "initial" else "optimal", reference_length=ref,
             seed=trial_seed(seed, index, spec, stop, trial),
-            milestones=tuple(f * inst.reference_length for f in factors), **overrides,
+            milestones=tuple(f * inst.reference_length for f in factors), config=config,
         )  # fmt: skip
         rows.append({
             "planner": spec.planner, "tau": np.nan if spec.tau is None else spec.tau,
@@ -84,7 +90,7 @@ def _job(args, seed: int, overrides: dict) -> list[dict]:
             "success": r.success, "cost": r.cost, "iterations": r.iterations,
             "tree_size": r.tree_size, "collision_checks": r.collision_checks,
             "time_to_first": r.time_to_first, "time_to_stop": r.time_to_stop,
-            "stop_reason": r.stop_reason, "reference_length": inst.reference_length,
+            "stop_reason": r.stop_reason, "reference_length": ref,
             "fallback_uniform": r.fallback_uniform,
             **{convergence_column(f): m.time for f, m in zip(factors, r.milestones)},
         })  # fmt: skip
@@ -97,12 +103,12 @@ def run_trials(
     trials: dict[tuple[str, str], int],
     seed: int = 0,
     workers: int = 0,
-    overrides: dict | None = None,
+    config: PlannerConfig | None = None,
 ) -> pd.DataFrame:
     """All trials as a table (columns :data:`TRIAL_COLUMNS` and a few more).
 
     ``trials[(map_set_kind, stop)]`` is the number of trials per instance, with
-    ``map_set_kind`` ``'named'`` (map_1 .. map_5) or ``'random'``. ``overrides`` are
+    ``map_set_kind`` ``'named'`` (map_1 .. map_5) or ``'random'``. ``config`` holds the
     planner settings (budgets, eta, ...) passed to :func:`vnrrt.planners.plan`.
     A trial that exhausts a budget is a row with ``success=False``.
     """
@@ -112,11 +118,13 @@ def run_trials(
         for spec in specs:
             if spec.heatmap is not None and spec.heatmap not in inst.heatmaps:
                 raise KeyError(f"instance {inst.map} has no '{spec.heatmap}' heatmap")
-            for stop in ("initial", "optimal"):
+            for stop in STOPS:
                 n = trials.get((kind, stop), 0)
+                if n > 0 and stop == "optimal_any_angle" and inst.any_angle_length is None:
+                    raise ValueError(f"instance {inst.map} has no any-angle length")
                 if n > 0:
                     jobs.append((i, inst, spec, stop, n))
-    job = functools.partial(_job, seed=seed, overrides=dict(overrides or {}))
+    job = functools.partial(_job, seed=seed, config=config or PlannerConfig())
     parts = parallel_map(job, jobs, workers, "trials")
     table = pd.DataFrame([row for rows in parts for row in rows])
     return table.reindex(columns=[*TRIAL_COLUMNS, *[c for c in table if c not in TRIAL_COLUMNS]])

@@ -60,27 +60,31 @@ class ResNetEncoder(nn.Module):
 
     Attributes ``conv1, bn1, relu, maxpool, layer1..layer4`` carry torchvision's names.
     ``channels`` lists the channel counts of the returned features, ``layer_counts`` the
-    number of basic blocks per stage.
+    number of basic blocks per stage. ``width`` scales every channel count (1.0: torchvision's
+    ResNet, the only width its weight files fit; 0.5: a 4x cheaper encoder for CPU runs).
     """
 
-    def __init__(self, name: str = "resnet34", in_channels: int = 3) -> None:
+    def __init__(self, name: str = "resnet34", in_channels: int = 3, width: float = 1.0) -> None:
         super().__init__()
         if name not in LAYERS:
             raise ValueError(f"unknown encoder {name!r}; expected one of {sorted(LAYERS)}")
-        self.name = name
+        if width <= 0:
+            raise ValueError(f"encoder width must be positive, got {width}")
+        self.name, self.width = name, width
         self.layer_counts = LAYERS[name]
-        self.conv1 = nn.Conv2d(in_channels, 64, 7, 2, 3, bias=False)
-        self.bn1 = nn.BatchNorm2d(64)
+        stem, *widths = (max(8, round(c * width)) for c in (64, 64, 128, 256, 512))
+        self.conv1 = nn.Conv2d(in_channels, stem, 7, 2, 3, bias=False)
+        self.bn1 = nn.BatchNorm2d(stem)
         self.relu = nn.ReLU(inplace=True)
         self.maxpool = nn.MaxPool2d(3, 2, 1)
-        widths, in_planes = (64, 128, 256, 512), 64
+        in_planes = stem
         for i, (planes, blocks) in enumerate(zip(widths, LAYERS[name], strict=True)):
             stride = 1 if i == 0 else 2
             stage = [BasicBlock(in_planes, planes, stride)]
             stage += [BasicBlock(planes, planes) for _ in range(blocks - 1)]
             self.add_module(f"layer{i + 1}", nn.Sequential(*stage))
             in_planes = planes
-        self.channels = (64, 64, 128, 256, 512)
+        self.channels = (stem, *widths)
         self._init_weights()
 
     def _init_weights(self) -> None:
@@ -96,7 +100,8 @@ class ResNetEncoder(nn.Module):
         """x: (B, C, H, W) -> features where the resolution changes, finest first.
 
         Returns [stem (B,64,H/2), layer1 (B,64,H/4), layer2 (B,128,H/8), layer3 (B,256,H/16),
-        layer4 (B,512,H/32)] (sizes rounded up, as the strided convolutions do).
+        layer4 (B,512,H/32)] (sizes rounded up, as the strided convolutions do; channels times
+        ``width``).
         """
         stem = self.relu(self.bn1(self.conv1(x)))  # (B, 64, H/2, W/2)
         f1 = self.layer1(self.maxpool(stem))  # (B, 64, H/4, W/4)

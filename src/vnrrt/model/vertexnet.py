@@ -17,6 +17,7 @@ final     shuffle-up (96,200), resize to the input, cat input (99,200), ResBlock
 from __future__ import annotations
 
 import logging
+import math
 from pathlib import Path
 
 import torch
@@ -123,6 +124,11 @@ class VertexNet(nn.Module):
         in_channels: input image channels.
         decoder_width: factor on every decoder convolution's width; 1.0 is fastai's decoder,
             smaller values give a cheaper network for CPU runs.
+        encoder_width: factor on the encoder's channel counts (:class:`ResNetEncoder`); 1.0
+            (the paper, and the only width torchvision weight files fit) or less for CPU runs.
+        prior: if set, the head's biases start so that every pixel's class-1 probability is
+            ``prior`` (Lin et al. 2017's init for focal loss: training does not first spend
+            steps learning that almost every pixel is background). None: fastai's init.
     """
 
     def __init__(
@@ -133,14 +139,18 @@ class VertexNet(nn.Module):
         freeze_encoder: bool = True,
         in_channels: int = 3,
         decoder_width: float = 1.0,
+        encoder_width: float = 1.0,
+        prior: float | None = None,
     ) -> None:
         super().__init__()
         if decoder_width <= 0:
             raise ValueError(f"decoder_width must be positive, got {decoder_width}")
         self.in_channels, self.out_channels = in_channels, out_channels
         self.decoder_width = decoder_width
-        self.encoder = ResNetEncoder(encoder, in_channels)
+        self.encoder = ResNetEncoder(encoder, in_channels, encoder_width)
         self._build_decoder(out_channels)
+        if prior is not None:
+            self._init_prior(prior)
         self.weights_path = resolve_weights(weights, encoder)
         if self.weights_path is not None:
             load_torchvision_weights(self.encoder, self.weights_path)
@@ -155,7 +165,7 @@ class VertexNet(nn.Module):
 
     def _build_decoder(self, out_channels: int) -> None:
         """Create middle, UNet blocks, final upsampling, residual block and head, as fastai does."""
-        *skips, ni = self.encoder.channels  # skips (64, 64, 128, 256), ni = 512
+        *skips, ni = self.encoder.channels  # skips (64, 64, 128, 256), ni = 512 (width 1)
         mid = self._width(ni)
         self.middle = nn.Sequential(
             batch_norm(ni),
@@ -176,6 +186,14 @@ class VertexNet(nn.Module):
         self.head = nn.Conv2d(up_c + self.in_channels, out_channels, 1)  # PyTorch default init
         nn.init.normal_(self.head.bias, 0.0, 0.01)
 
+    @torch.no_grad()
+    def _init_prior(self, prior: float) -> None:
+        """Biases 0 for class 0 and ``log(prior / (1 - prior))`` for the others."""
+        if not 0.0 < prior < 1.0:
+            raise ValueError(f"prior must be in (0, 1), got {prior}")
+        self.head.bias.zero_()
+        self.head.bias[1:] = math.log(prior / (1.0 - prior))
+
     def set_encoder_frozen(self, frozen: bool = True) -> None:
         """Freeze (or unfreeze) the encoder's weights; its BatchNorm parameters stay trainable.
 
@@ -194,6 +212,7 @@ class VertexNet(nn.Module):
             "weights": str(self.weights_path) if self.weights_path else "none",
             "encoder_frozen": self.encoder_frozen,
             "decoder_width": self.decoder_width,
+            "encoder_width": self.encoder.width,
             "params_total": sum(p.numel() for p in self.parameters()),
             "params_trainable": sum(p.numel() for p in self.parameters() if p.requires_grad),
         }

@@ -1,0 +1,115 @@
+"""Training: a fast_dev_run of the real smoke config, learning on a handful of instances,
+resuming from a checkpoint and clear errors for missing or mismatched checkpoints."""
+
+import json
+import shutil
+
+import pytest
+import torch
+from hydra.utils import instantiate
+
+from tests.train_helpers import QUICK, paths, small_cfg
+from vnrrt.callbacks import LogProgress
+from vnrrt.config import compose
+from vnrrt.model.checkpoint import CheckpointError, load_network, read_checkpoint
+from vnrrt.model.metrics import VertexRecall
+from vnrrt.train import train
+
+
+def test_fast_dev_run_of_the_real_smoke_config(smoke_data, tmp_path):
+    cfg = compose(["scale=smoke", *paths(smoke_data, tmp_path), "logger.enabled=false",
+                   "+trainer.fast_dev_run=true"])  # fmt: skip
+    metrics = train(cfg, "vertexnet")
+    assert metrics["steps"] == 1 and 0 <= metrics["test/ap"] <= 1
+    saved = json.loads((tmp_path / "metrics" / "train_vertexnet.json").read_text())
+    assert saved["steps"] == 1 and "test/mass_near_vertex_uniform" in saved
+    net, record = load_network(tmp_path / "models" / "vertexnet.ckpt", "vertexnet")
+    assert record["target"] == {"kind": "vertex", "radius": 0.0}
+    assert record["net"]["encoder_width"] == cfg.model.net.encoder_width
+    assert net(torch.rand(1, 3, 200, 200)).shape == (1, 2, 200, 200)
+
+
+def recall_on(net, batch) -> float:
+    with torch.no_grad():
+        probs = net.eval()(batch["image"]).softmax(1)[:, 1]
+    return float(VertexRecall(radius=1.0, tau=0.5)(probs, batch["vertices"]))
+
+
+def test_overfitting_a_handful_of_instances_drives_vertex_recall_up(small_data, tmp_path):
+    cfg = small_cfg(small_data, tmp_path, "train.datamodule.train_instances=4",
+                    "train.datamodule.batch_size=4", "trainer.max_epochs=80",
+                    "trainer.limit_val_batches=0", "networks.vertexnet.radius=1.0",
+                    "train.module.scheduler=null", "train.module.optimizer.lr=3e-3")  # fmt: skip
+    dm = instantiate(cfg.train.datamodule, target="vertex", target_radius=1.0)
+    dm.setup("fit")
+    batch = next(iter(dm.train_dataloader()))
+    assert len(batch["image"]) == 4
+    torch.manual_seed(0)
+    before = recall_on(instantiate(cfg.model.net), batch)
+    train(cfg, "vertexnet")
+    after = recall_on(load_network(tmp_path / "models" / "vertexnet.ckpt")[0], batch)
+    assert before == 0.0 and after >= 0.8, (before, after)
+
+
+def test_a_resumed_run_ends_where_an_uninterrupted_one_does(small_data, tmp_path, monkeypatch):
+    """Stop a 2-epoch run after epoch 0, resume it from its last.ckpt: same steps, same
+    schedule, same batches, hence the same final weights as a run never stopped."""
+    two = [*QUICK, "trainer.max_epochs=2", "train.module.scheduler.pct_start=0.5"]
+    full = train(small_cfg(small_data, tmp_path / "full", *two), "vertexnet")
+
+    def crash(self, trainer, pl_module):
+        if trainer.current_epoch == 1:
+            raise RuntimeError("interrupted")
+
+    with monkeypatch.context() as m:
+        m.setattr(LogProgress, "on_train_epoch_start", crash)
+        with pytest.raises(RuntimeError, match="interrupted"):
+            train(small_cfg(small_data, tmp_path / "cut", *two), "vertexnet")
+    last = tmp_path / "last.ckpt"
+    shutil.copy(tmp_path / "cut" / "models" / "checkpoints" / "vertexnet" / "last.ckpt", last)
+    assert read_checkpoint(last)["global_step"] == 2
+    resumed = train(small_cfg(small_data, tmp_path / "cut", *two,
+                              f"networks.vertexnet.resume={last}"), "vertexnet")  # fmt: skip
+    assert resumed["steps"] == full["steps"] == 4 and resumed["epochs"] == 2
+    want = read_checkpoint(tmp_path / "full" / "models" / "vertexnet.ckpt")["state_dict"]
+    got = read_checkpoint(tmp_path / "cut" / "models" / "vertexnet.ckpt")["state_dict"]
+    for key, value in want.items():
+        torch.testing.assert_close(got[key], value, msg=key)
+
+
+@pytest.mark.parametrize(
+    ("override", "message"),
+    [
+        ("networks.vertexnet.resume={missing}", r"checkpoint .*nothing\.ckpt does not exist"),
+        ("networks.vertexnet.resume={garbage}", r"checkpoint .*garbage\.ckpt is unreadable"),
+        ("networks.vertexnet.resume={other}", r"record\.network: checkpoint 'nrrtnet', config "
+                                              r"'vertexnet'.*record\.target\.kind"),
+        ("model.net.decoder_width=0.5", r"record\.net\.decoder_width: checkpoint 0\.25, "
+                                        r"config 0\.5"),
+    ],
+)  # fmt: skip
+def test_missing_or_mismatched_checkpoints_are_named(small_data, trained, tmp_path, override,
+                                                     message):  # fmt: skip
+    (tmp_path / "garbage.ckpt").write_bytes(b"not a checkpoint")
+    files = {"missing": tmp_path / "nothing.ckpt", "garbage": tmp_path / "garbage.ckpt",
+             "other": trained / "models" / "nrrtnet.ckpt"}  # fmt: skip
+    own = f"networks.vertexnet.resume={trained / 'models' / 'vertexnet.ckpt'}"
+    cfg = small_cfg(small_data, tmp_path, *QUICK, own, override.format(**files))
+    with pytest.raises(CheckpointError, match=message):
+        train(cfg, "vertexnet")
+    assert not (tmp_path / "models" / "vertexnet.ckpt").exists()
+
+
+def test_loading_checks_the_network_and_the_weights(trained, tmp_path):
+    with pytest.raises(CheckpointError, match="holds 'nrrtnet', not 'vertexnet'"):
+        load_network(trained / "models" / "nrrtnet.ckpt", "vertexnet")
+    ckpt = read_checkpoint(trained / "models" / "vertexnet.ckpt")
+    del ckpt["state_dict"]["net.head.bias"]
+    torch.save(ckpt, tmp_path / "cut.ckpt")
+    with pytest.raises(CheckpointError, match=r"cut\.ckpt does not fit the network: missing: "
+                                              r"head\.bias"):  # fmt: skip
+        load_network(tmp_path / "cut.ckpt")
+    ckpt.pop("vnrrt")
+    torch.save(ckpt, tmp_path / "foreign.ckpt")
+    with pytest.raises(CheckpointError, match="not written by vnrrt.train"):
+        load_network(tmp_path / "foreign.ckpt")
