@@ -36,6 +36,8 @@ def workdir(tmp_path_factory, repo):
     run(["git", "init", "-q"], work)
     run(["dvc", "init", "-q"], work)
     shutil.copy(repo / ".dvc" / "config", work / ".dvc" / "config")
+    (work / "reports" / "paper").mkdir(parents=True)
+    shutil.copy(repo / "reports/paper/tables.yaml", work / "reports/paper/tables.yaml")
     (work / "params.yaml").write_text(dump(compose(["scale=smoke"])))
     return work
 
@@ -65,3 +67,31 @@ def test_an_interrupted_run_resumes_after_the_last_finished_shard(workdir):
     out = run(["dvc", "repro", *DATA_STAGES], workdir)
     assert "Running stage 'shard@1'" in out and "Running stage 'shard@0'" not in out
     assert not list((workdir / "data").rglob("*.tmp-*"))
+
+
+def test_smoke_dvc_repro_end_to_end_writes_report_metrics_and_mlflow_runs(workdir):
+    """Every stage at smoke scale: training, prediction, evaluation, report and MLflow."""
+    from mlflow import MlflowClient
+
+    env_uri = os.environ.pop("MLFLOW_TRACKING_URI", None)
+    try:
+        run(["dvc", "repro"], workdir)
+    finally:
+        if env_uri is not None:
+            os.environ["MLFLOW_TRACKING_URI"] = env_uri
+    report = (workdir / "reports" / "paper_comparison.md").read_text()
+    assert "| vnrrt_star | ours | " in report and "| m_vnrrt_star@0.5 | ours | " in report
+    assert "ok" in report.split("## Table 3")[1]  # our cells hold numbers and success counts
+    metrics = json.loads((workdir / "reports" / "metrics" / "eval.json").read_text())
+    assert metrics["optimal"]["rrt_star"]["random"]["success_rate"] > 0.5
+    assert metrics["initial"]["vnrrt_star"]["map_3"]["time_median"] > 0
+    client = MlflowClient(f"sqlite:///{workdir / 'mlflow.db'}")
+    exp = client.get_experiment_by_name("vnrrt")
+    runs = client.search_runs([exp.experiment_id])
+    stages = sorted(r.data.tags.get("dvc_stage", "") for r in runs)
+    assert stages.count("train_vertexnet") == 1 and stages.count("train_nrrtnet") == 1
+    parents = [r for r in runs if r.data.tags.get("kind") == "evaluation"
+               and "mlflow.parentRunId" not in r.data.tags]  # fmt: skip
+    children = [r for r in runs if r.data.tags.get("mlflow.parentRunId") == parents[0].info.run_id]
+    assert len(parents) == 1 and len(children) == 6
+    assert all(c.data.metrics["optimal/random/success_rate"] >= 0 for c in children)
