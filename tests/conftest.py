@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import shutil
 from pathlib import Path
 
 import numpy as np
@@ -57,3 +58,19 @@ def trained(small_data, tmp_path_factory) -> Path:
     for name in ("vertexnet", "nrrtnet"):
         train(cfg, name)
     return out
+
+
+PIPELINE_FILES = ["dvc.yaml", "conf", "stages", "src", ".dvcignore", "reports/paper/tables.yaml"]
+
+
+def copy_pipeline(repo: Path, dest: Path) -> Path:
+    """Copy what `dvc repro` needs (pipeline, config, code, the paper's tables) into ``dest``
+    for tests that run DVC in a scratch repository; returns ``dest``."""
+    for name in PIPELINE_FILES:
+        src, dst = repo / name, dest / name
+        dst.parent.mkdir(parents=True, exist_ok=True)
+        if src.is_dir():
+            shutil.copytree(src, dst, ignore=shutil.ignore_patterns("__pycache__"))
+        else:
+            shutil.copy(src, dst)
+    return dest

@@ -11,11 +11,11 @@ from pathlib import Path
 
 import pytest
 
+from tests.conftest import copy_pipeline
 from vnrrt.config import DataConfig, LabelsConfig, ScaleConfig, compose, section
 from vnrrt.data.build import build_shard
 from vnrrt.data.shards import shard_file
 
-COPY = ["dvc.yaml", "conf", "stages", "src", ".dvcignore"]
 SMOKE = ["scale=smoke"]
 SHARDS = (0, 1)
 SWEEP = "multirun/test"  # Hydra's sweep dir, relative to the scratch copy
@@ -45,12 +45,7 @@ def expected(tmp_path_factory) -> dict[int, bytes]:
 def scratch(tmp_path, repo) -> tuple[Path, dict]:
     """A scratch copy of the pipeline with a DVC repo (no git) and smoke ``params.yaml``,
     and the environment to run commands in it."""
-    for name in COPY:
-        src = repo / name
-        if src.is_dir():
-            shutil.copytree(src, tmp_path / name, ignore=shutil.ignore_patterns("__pycache__"))
-        else:
-            shutil.copy(src, tmp_path / name)
+    copy_pipeline(repo, tmp_path)
     bin_dir = Path(sys.executable).parent
     env = dict(
         os.environ,

@@ -9,12 +9,11 @@ from pathlib import Path
 
 import pytest
 
+from tests.conftest import copy_pipeline
 from vnrrt.config import DataConfig, LabelsConfig, compose, dump
 from vnrrt.data.build import build_shard
 from vnrrt.data.manifest import verify_manifest
 from vnrrt.data.shards import shard_file
-
-COPY = ["dvc.yaml", "conf", "stages", "src", ".dvcignore"]
 
 
 def run(cmd: list[str], cwd: Path) -> str:
@@ -26,18 +25,10 @@ def run(cmd: list[str], cwd: Path) -> str:
 
 @pytest.fixture(scope="module")
 def workdir(tmp_path_factory, repo):
-    work = tmp_path_factory.mktemp("pipeline")
-    for name in COPY:
-        src = repo / name
-        if src.is_dir():
-            shutil.copytree(src, work / name, ignore=shutil.ignore_patterns("__pycache__"))
-        else:
-            shutil.copy(src, work / name)
+    work = copy_pipeline(repo, tmp_path_factory.mktemp("pipeline"))
     run(["git", "init", "-q"], work)
     run(["dvc", "init", "-q"], work)
     shutil.copy(repo / ".dvc" / "config", work / ".dvc" / "config")
-    (work / "reports" / "paper").mkdir(parents=True)
-    shutil.copy(repo / "reports/paper/tables.yaml", work / "reports/paper/tables.yaml")
     (work / "params.yaml").write_text(dump(compose(["scale=smoke"])))
     return work
 

@@ -2,7 +2,6 @@
 
 import json
 import os
-import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -10,6 +9,7 @@ from pathlib import Path
 import pytest
 from mlflow import MlflowClient
 
+from tests.conftest import copy_pipeline
 from tests.train_helpers import QUICK, SMALL, paths
 from vnrrt.config import compose, dump
 from vnrrt.data.heatmaps import read_heatmaps
@@ -44,12 +44,7 @@ def test_ddp_trains_on_two_cpu_processes(small_data, tmp_path):
 
 
 def test_dvc_repro_trains_both_networks_and_predicts(tmp_path):
-    for name in ["dvc.yaml", "conf", "stages", "src", ".dvcignore"]:
-        src = REPO / name
-        if src.is_dir():
-            shutil.copytree(src, tmp_path / name, ignore=shutil.ignore_patterns("__pycache__"))
-        else:
-            shutil.copy(src, tmp_path / name)
+    copy_pipeline(REPO, tmp_path)
     run(["git", "init", "-q"], tmp_path)
     run(["dvc", "init", "-q"], tmp_path)
     (tmp_path / "params.yaml").write_text(dump(compose(["scale=smoke"])))
