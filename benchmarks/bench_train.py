@@ -87,7 +87,7 @@ def bench(args: argparse.Namespace, overrides: list[str], device: torch.device) 
             break
     loader = n / (time.perf_counter() - start)
     data = dm.datasets["test"]
-    _, _, sec = predict_dataset(net.eval(), data, args.batch, device)
+    _, sec = predict_dataset(net.eval(), data, args.batch, device)
     return {"pipeline": pipeline, "baseline": baseline, "loader": loader, "ms_per_map": 1e3 * sec,
             "params": sum(p.numel() for p in net.parameters())}  # fmt: skip
 

@@ -1,14 +1,7 @@
-"""DVC stage evaluate (see vnrrt.evaluation.stage.run_evaluate)."""
+"""DVC stage evaluate: merged trials, summary metrics and convergence curves."""
 
-import argparse
-import logging
-
-from vnrrt.config import load_params
 from vnrrt.evaluation.stage import run_evaluate
+from vnrrt.stage_cli import stage_main
 
 if __name__ == "__main__":
-    parser = argparse.ArgumentParser(description=__doc__)
-    parser.add_argument("--params", default="params.yaml")
-    args = parser.parse_args()
-    logging.basicConfig(level=logging.INFO, format="%(levelname)s %(name)s: %(message)s")
-    run_evaluate(load_params(args.params))
+    stage_main(run_evaluate, __doc__)

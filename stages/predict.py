@@ -1,14 +1,7 @@
-"""DVC stage predict: heatmaps of both networks for the evaluation instances (vnrrt.pipeline)."""
+"""DVC stage predict@<k>: heatmaps of the networks for part k of the evaluation instances."""
 
-import argparse
-import logging
-
-from vnrrt.config import load_params
-from vnrrt.pipeline import run_predict
+from vnrrt.pipeline import run_predict_part
+from vnrrt.stage_cli import stage_main
 
 if __name__ == "__main__":
-    parser = argparse.ArgumentParser(description=__doc__)
-    parser.add_argument("--params", default="params.yaml")
-    args = parser.parse_args()
-    logging.basicConfig(level=logging.INFO, format="%(levelname)s %(name)s: %(message)s")
-    run_predict(load_params(args.params))
+    stage_main(run_predict_part, __doc__, "part", int, "part id (predict.parts)")

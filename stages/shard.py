@@ -1,15 +1,7 @@
-"""DVC stage shard@<id>: generate and label one shard of maps (see vnrrt.pipeline)."""
+"""DVC stage shard@<id>: generate and label one shard of maps (vnrrt.pipeline.run_shard)."""
 
-import argparse
-import logging
-
-from vnrrt.config import load_params
 from vnrrt.pipeline import run_shard
+from vnrrt.stage_cli import stage_main
 
 if __name__ == "__main__":
-    parser = argparse.ArgumentParser(description=__doc__)
-    parser.add_argument("--shard", type=int, required=True, help="shard id (scale.shards)")
-    parser.add_argument("--params", default="params.yaml")
-    args = parser.parse_args()
-    logging.basicConfig(level=logging.INFO, format="%(levelname)s %(name)s: %(message)s")
-    run_shard(load_params(args.params), args.shard)
+    stage_main(run_shard, __doc__, "shard", int, "shard id (scale.shards)")

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import os
 import shutil
+import subprocess
+from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
@@ -74,3 +76,21 @@ def copy_pipeline(repo: Path, dest: Path) -> Path:
         else:
             shutil.copy(src, dst)
     return dest
+
+
+@pytest.fixture(scope="session")
+def slurm(tmp_path_factory, repo) -> Iterator[str]:
+    """A one-node SLURM cluster on localhost (scripts/slurm/start.sh) for the test session;
+    yields its ``SLURM_CONF`` and stops every daemon afterwards."""
+    if not (shutil.which("slurmctld") and shutil.which("slurmd") and shutil.which("munged")):
+        pytest.skip("slurmctld/slurmd/munged not installed (run .ci/slurm-setup)")
+    if os.geteuid() != 0:
+        pytest.skip("a local slurmd must run as root")
+    state = tmp_path_factory.mktemp("slurm")
+    start, stop = repo / "scripts/slurm/start.sh", repo / "scripts/slurm/stop.sh"
+    try:
+        proc = subprocess.run([start, state], capture_output=True, text=True, timeout=120)
+        assert proc.returncode == 0, f"cluster did not start:\n{proc.stdout}\n{proc.stderr}"
+        yield str(state / "slurm.conf")
+    finally:
+        subprocess.run([stop, state], capture_output=True, timeout=120, check=False)

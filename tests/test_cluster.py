@@ -3,10 +3,8 @@ submitit on a real one-node SLURM cluster: the shard files are byte for byte tho
 ``shard@<id>``, and ``dvc commit`` makes ``dvc repro`` skip them."""
 
 import os
-import shutil
 import subprocess
 import sys
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -62,7 +60,7 @@ def scratch(tmp_path, repo) -> tuple[Path, dict]:
 def multirun(work: Path, env: dict, *overrides: str) -> str:
     """``python -m vnrrt.multirun -m`` over the smoke shards, one core per job."""
     ids = ",".join(map(str, SHARDS))
-    cmd = [sys.executable, "-m", "vnrrt.multirun", "-m", f"+shard_id={ids}", *SMOKE]
+    cmd = [sys.executable, "-m", "vnrrt.multirun", "-m", "+stage=shard", f"+part={ids}", *SMOKE]
     return run([*cmd, "workers=1", f"hydra.sweep.dir={SWEEP}", *overrides], work, env)
 
 
@@ -86,24 +84,6 @@ def test_joblib_multirun_writes_the_stage_shards_and_dvc_commit_makes_them_curre
         assert f"Stage 'shard@{s}' didn't change" in out
     assert "Running stage 'manifest'" in out
     assert_same_shards(work, expected)
-
-
-@pytest.fixture(scope="module")
-def slurm(tmp_path_factory, repo) -> Iterator[str]:
-    """A one-node SLURM cluster on localhost (scripts/slurm/start.sh) for this module;
-    yields its ``SLURM_CONF`` and stops every daemon afterwards."""
-    if not (shutil.which("slurmctld") and shutil.which("slurmd") and shutil.which("munged")):
-        pytest.skip("slurmctld/slurmd/munged not installed (run .ci/slurm-setup)")
-    if os.geteuid() != 0:
-        pytest.skip("a local slurmd must run as root")
-    state = tmp_path_factory.mktemp("slurm")
-    start, stop = repo / "scripts/slurm/start.sh", repo / "scripts/slurm/stop.sh"
-    try:
-        proc = subprocess.run([start, state], capture_output=True, text=True, timeout=120)
-        assert proc.returncode == 0, f"cluster did not start:\n{proc.stdout}\n{proc.stderr}"
-        yield str(state / "slurm.conf")
-    finally:
-        subprocess.run([stop, state], capture_output=True, timeout=120, check=False)
 
 
 def test_submitit_slurm_multirun_writes_the_stage_shards(scratch, expected, slurm):

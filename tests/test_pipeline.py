@@ -7,17 +7,22 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
+import pandas as pd
 import pytest
 
 from tests.conftest import copy_pipeline
 from vnrrt.config import DataConfig, LabelsConfig, compose, dump
 from vnrrt.data.build import build_shard
+from vnrrt.data.heatmaps import read_heatmaps
 from vnrrt.data.manifest import verify_manifest
 from vnrrt.data.shards import shard_file
+from vnrrt.evaluation.evaluate import read_trials
 
 
-def run(cmd: list[str], cwd: Path) -> str:
+def run(cmd: list[str], cwd: Path, **env_vars: str) -> str:
     env = dict(os.environ, PATH=f"{Path(sys.executable).parent}{os.pathsep}{os.environ['PATH']}")
+    env.update(env_vars)
     proc = subprocess.run(cmd, cwd=cwd, env=env, capture_output=True, text=True, check=False)
     assert proc.returncode == 0, f"{' '.join(cmd)} failed:\n{proc.stdout}\n{proc.stderr}"
     return proc.stdout + proc.stderr
@@ -86,3 +91,54 @@ def test_smoke_dvc_repro_end_to_end_writes_report_metrics_and_mlflow_runs(workdi
     children = [r for r in runs if r.data.tags.get("mlflow.parentRunId") == parents[0].info.run_id]
     assert len(parents) == 1 and len(children) == 6
     assert all(c.data.metrics["optimal/random/success_rate"] >= 0 for c in children)
+
+
+# Trial columns that depend on seeds and inputs only, not on timing or the machine's load.
+DETERMINISTIC = ["planner", "tau", "map_set", "map", "trial", "stop", "success", "cost",
+                 "iterations", "tree_size", "collision_checks", "reference_length",
+                 "seq"]  # fmt: skip
+
+
+def test_predict_and_trial_parts_as_multirun_jobs_write_the_stage_files(workdir, request):
+    """After the end-to-end run: the predict@<k> and trials@<k> parts again, as Hydra
+    multirun shard jobs (joblib; trials on the local SLURM cluster where it runs). They write
+    the stages' files: heatmaps equal up to float16 rounding (threads differ), trials equal in
+    every column but the timings given the same heatmaps; `dvc commit` makes `dvc repro`
+    skip the stages."""
+    heat, trials = workdir / "data" / "heatmaps", workdir / "reports" / "eval" / "trials"
+    stage_bytes = {p.name: p.read_bytes() for p in sorted(heat.glob("part_*.npz"))}
+    stage_heat = {name: read_heatmaps(heat / name) for name in stage_bytes}
+    stage_trials = read_trials(trials, [0, 1])
+    assert len(stage_heat) == 2
+    shutil.rmtree(heat)
+    shutil.rmtree(trials)
+    env = {"VNRRT_CONF_DIR": str(workdir / "conf")}
+    # the overrides of params.yaml (test_an_interrupted_run... wrote seed=1)
+    job = [sys.executable, "-m", "vnrrt.multirun", "-m", "scale=smoke", "seed=1", "workers=1",
+           "+part=0,1"]  # fmt: skip
+    out = run([*job, "+stage=predict", "hydra/launcher=local"], workdir, **env)
+    assert "differs from params.yaml" not in out
+    for name, want in stage_heat.items():
+        got = read_heatmaps(heat / name)
+        np.testing.assert_array_equal(got["keys"], want["keys"])
+        for net, maps in want["maps"].items():
+            # equal up to float16 rounding: CPU threads (1 per joblib job) change sum orders
+            np.testing.assert_allclose(got["maps"][net].astype(np.float32), maps, rtol=4e-3,
+                                       atol=1e-4, err_msg=f"{name} {net}")  # fmt: skip
+    for name, data in stage_bytes.items():  # the trials below run on the stage's heatmaps
+        (heat / name).write_bytes(data)
+    try:
+        env["SLURM_CONF"] = request.getfixturevalue("slurm")
+        launcher = ["hydra/launcher=slurm", "hydra.launcher.cpus_per_task=1",
+                    "hydra.launcher.mem_gb=2", "hydra.launcher.timeout_min=10"]  # fmt: skip
+    except pytest.skip.Exception:
+        launcher = ["hydra/launcher=local"]
+    run([*job, "+stage=trials", *launcher], workdir, **env)
+    got = read_trials(trials, [0, 1])
+    pd.testing.assert_frame_equal(got[DETERMINISTIC], stage_trials[DETERMINISTIC])
+
+    run(["dvc", "commit", "-f", "predict", "trials"], workdir)
+    out = run(["dvc", "repro", "evaluate"], workdir)
+    for stage in ("predict@0", "predict@1", "trials@0", "trials@1"):
+        assert f"Stage '{stage}' didn't change" in out
+    assert "Running stage 'evaluate'" in out

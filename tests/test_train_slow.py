@@ -12,7 +12,7 @@ from mlflow import MlflowClient
 from tests.conftest import copy_pipeline
 from tests.train_helpers import QUICK, SMALL, paths
 from vnrrt.config import compose, dump
-from vnrrt.data.heatmaps import read_heatmaps
+from vnrrt.data.heatmaps import read_heatmaps, read_parts
 from vnrrt.model.checkpoint import load_network
 
 pytestmark = pytest.mark.slow
@@ -48,15 +48,17 @@ def test_dvc_repro_trains_both_networks_and_predicts(tmp_path):
     run(["git", "init", "-q"], tmp_path)
     run(["dvc", "init", "-q"], tmp_path)
     (tmp_path / "params.yaml").write_text(dump(compose(["scale=smoke"])))
-    run(["dvc", "repro", "predict"], tmp_path)
+    run(["dvc", "repro", "predict_named"], tmp_path)
+    named = read_heatmaps(tmp_path / "data" / "heatmaps_named.npz")
+    test = read_parts(tmp_path / "data" / "heatmaps", [0, 1])
     for name, kind in (("vertexnet", "vertex"), ("nrrtnet", "path")):
         _, record = load_network(tmp_path / "models" / f"{name}.ckpt", name)
         assert record["target"]["kind"] == kind
-        h = read_heatmaps(tmp_path / "data" / "heatmaps" / f"{name}.npz")
-        assert h["named"].shape == (5, 200, 200) and h["test"].shape == (8, 200, 200)
+        assert named["maps"][name].shape == (5, 200, 200)
+        assert test["maps"][name].shape == (8, 200, 200)
     shown = run(["dvc", "metrics", "show", "--json"], tmp_path)
     assert "train_vertexnet.json" in shown and "predict.json" in shown
     client = MlflowClient(f"sqlite:///{tmp_path / 'mlflow.db'}")  # <repo>/mlflow.db
     runs = client.search_runs([client.get_experiment_by_name("vnrrt").experiment_id])
     assert sorted(r.data.tags["dvc_stage"] for r in runs) == ["train_nrrtnet", "train_vertexnet"]
-    assert "didn't change" in run(["dvc", "repro", "predict"], tmp_path)
+    assert "didn't change" in run(["dvc", "repro", "predict_named"], tmp_path)

@@ -46,6 +46,7 @@ def paths(data: Path, out: Path) -> list[str]:
         f"paths.metrics={out / 'metrics'}",
         f"paths.figures={out / 'figures'}",
         f"paths.heatmaps={out / 'heatmaps'}",
+        f"paths.named_heatmaps={out / 'heatmaps_named.npz'}",
         f"logger.uri=sqlite:///{out / 'mlflow.db'}",
         f"logger.artifact_location={out / 'mlartifacts'}",
     ]

@@ -92,6 +92,17 @@ class ScaleConfig:
         return len(self.shards) * self.maps_per_shard
 
 
+def check_parts(parts, key: str) -> list[int]:
+    """``parts`` (the ids of a stage's parts, e.g. ``eval.parts``) as a list of ints;
+    :class:`ConfigError` naming ``key`` unless it is ``[0, 1, ..., K-1]`` with K >= 1."""
+    try:
+        ids = None if isinstance(parts, str) else [int(p) for p in parts]
+    except (TypeError, ValueError):
+        ids = None
+    _check(bool(ids) and ids == list(range(len(ids))), key, parts, "must be [0, 1, ..., K-1]")
+    return ids
+
+
 def _check(ok: bool, key: str, value: Any, why: str) -> None:
     if not ok:
         raise ConfigError(f"invalid config value {key}={value!r}: {why}")

@@ -1,19 +1,23 @@
-"""Shard jobs as a Hydra app: one job builds one shard, the very file ``dvc repro`` writes.
+"""Shard jobs as a Hydra app: one job runs one part of a stage with parts, writing the very
+file ``dvc repro`` writes.
 
-The app composes the pipeline's own config (``conf/config.yaml``) plus a ``shard_id`` given
-on the command line, and calls :func:`vnrrt.pipeline.run_shard`, as stage ``shard@<id>``
-does. Hydra's launchers spread a sweep over shard ids (``docs/scaling.md``); run from the
-repository root::
+The stages with parts (:data:`vnrrt.pipeline.PART_STAGES`) are ``shard`` (``shard@<id>``,
+ids ``scale.shards``: map generation and labelling), ``predict`` (``predict@<k>``, ids
+``predict.parts``: heatmap prediction) and ``trials`` (``trials@<k>``, ids ``eval.parts``:
+planner trials). The app composes the pipeline's own config (``conf/config.yaml``) plus
+``+stage=<name> +part=<id>`` from the command line and calls the stage's entry point.
+Hydra's launchers spread a sweep over ids (``docs/scaling.md``); run from the repository
+root::
 
     python -m vnrrt.config scale=paper > params.yaml   # the same overrides as the jobs
-    python -m vnrrt.multirun -m hydra/launcher=local +shard_id=0,1,2,3 workers=1
-    python -m vnrrt.multirun -m hydra/launcher=slurm +shard_id='range(0,100)' scale=paper
+    python -m vnrrt.multirun -m hydra/launcher=local +stage=shard +part=0,1,2,3 workers=1
+    python -m vnrrt.multirun -m hydra/launcher=slurm +stage=shard +part='range(0,100)' scale=paper
     dvc commit -f shard                                 # `dvc repro` then skips shard@*
 
 Relative ``paths`` resolve against the directory the command was started in (Hydra's
 ``runtime.cwd``), whatever directory a launcher runs a job in; Hydra's own outputs go to
 ``outputs/`` and ``multirun/``. A job whose config differs from ``params.yaml`` logs a
-warning: ``dvc commit`` would record parameters the shards were not built with.
+warning: ``dvc commit`` would record parameters the files were not built with.
 """
 
 from __future__ import annotations
@@ -27,12 +31,12 @@ from hydra.utils import to_absolute_path
 from omegaconf import DictConfig, OmegaConf
 
 from vnrrt.config import CONF_DIR, ConfigError, load_params
-from vnrrt.pipeline import run_shard
+from vnrrt.pipeline import PART_STAGES
 
 log = logging.getLogger(__name__)
 
-SHARD_KEY = "shard_id"  # the one key this app adds to the pipeline's config
-NOT_IN_OUTPUTS = {SHARD_KEY, "workers"}  # keys that do not change a shard's bytes
+STAGE_KEY, PART_KEY = "stage", "part"  # the keys this app adds to the pipeline's config
+NOT_IN_OUTPUTS = {STAGE_KEY, PART_KEY, "workers"}  # keys that do not change a job's output
 
 
 def with_absolute_paths(cfg: DictConfig) -> DictConfig:
@@ -45,7 +49,7 @@ def with_absolute_paths(cfg: DictConfig) -> DictConfig:
 
 def params_differences(cfg: DictConfig, params_file: str | Path) -> list[str]:
     """Top-level keys whose values differ between ``cfg`` and the file, less those that do
-    not change a shard (``shard_id``, ``workers``).
+    not change a job's output (``stage``, ``part``, ``workers``).
 
     Returns ``[]`` when the file does not exist (nothing for ``dvc commit`` to disagree with).
     """
@@ -57,11 +61,18 @@ def params_differences(cfg: DictConfig, params_file: str | Path) -> list[str]:
     return sorted(k for k in keys if mine.get(k) != theirs.get(k))
 
 
-def shard_job(cfg: DictConfig) -> dict:
-    """Build shard ``cfg.shard_id`` into ``paths.shards``; returns :func:`run_shard`'s counts."""
-    shard_id = cfg.get(SHARD_KEY)
-    if shard_id is None:
-        raise ConfigError(f"no shard id: pass +{SHARD_KEY}=<id>, or sweep with -m +{SHARD_KEY}=0,1")
+def part_job(cfg: DictConfig) -> object:
+    """Run part ``cfg.part`` of stage ``cfg.stage`` into the stage's files; returns what
+    the stage's entry point returns."""
+    stage, part = cfg.get(STAGE_KEY), cfg.get(PART_KEY)
+    if stage not in PART_STAGES or part is None:
+        raise ConfigError(f"pass +{STAGE_KEY}=<{'|'.join(PART_STAGES)}> and +{PART_KEY}=<id> "
+                          f"(got {STAGE_KEY}={stage!r}, {PART_KEY}={part!r}); sweep with "
+                          f"-m +{PART_KEY}=0,1")  # fmt: skip
+    run, ids_key = PART_STAGES[stage]
+    ids = OmegaConf.select(cfg, ids_key)
+    if int(part) not in list(ids):
+        raise ConfigError(f"{PART_KEY}={part} is not in {ids_key}={list(ids)}")
     differ = params_differences(cfg, to_absolute_path("params.yaml"))
     if differ:
         log.warning(
@@ -69,13 +80,13 @@ def shard_job(cfg: DictConfig) -> dict:
             "(python -m vnrrt.config ... > params.yaml) before `dvc commit`",
             differ,
         )
-    return run_shard(with_absolute_paths(cfg), int(shard_id))
+    return run(with_absolute_paths(cfg), int(part))
 
 
 @hydra.main(config_path=str(CONF_DIR), config_name="config", version_base="1.3")
-def main(cfg: DictConfig) -> dict:
-    """Hydra entry point (``python -m vnrrt.multirun [-m] +shard_id=... [overrides]``)."""
-    return shard_job(cfg)
+def main(cfg: DictConfig) -> object:
+    """Hydra entry point (``python -m vnrrt.multirun [-m] +stage=... +part=... [overrides]``)."""
+    return part_job(cfg)
 
 
 if __name__ == "__main__":

@@ -2,12 +2,15 @@
 picks and validates the sections it needs, and calls one computation.
 
 Paths come from the ``paths`` config group only. Stage scripts under ``stages/`` are thin
-wrappers around these functions.
+wrappers around these functions (:func:`vnrrt.stage_cli.stage_main`). The stages with parts
+(``shard@<id>``, ``predict@<k>``, ``trials@<k>``) are also the shard jobs of
+:mod:`vnrrt.multirun` (:data:`PART_STAGES`).
 """
 
 from __future__ import annotations
 
 import logging
+from collections.abc import Callable
 
 from omegaconf import DictConfig
 
@@ -64,19 +67,27 @@ def run_train(cfg: DictConfig, network: str) -> dict:
     return train(cfg, network)
 
 
-def run_predict(cfg: DictConfig) -> dict:
-    """Stage ``predict``: heatmaps of the trained networks for the evaluation instances
-    (:mod:`vnrrt.predict`), their metrics, and the paper's Fig. 3 on the named maps."""
+def run_predict_part(cfg: DictConfig, part: int) -> dict:
+    """Stage ``predict@<part>``: heatmaps of the trained networks for part ``part`` of the
+    evaluation instances (:func:`vnrrt.predict.predict_part`)."""
+    from vnrrt.predict import predict_part
+
+    return predict_part(cfg, part)
+
+
+def run_predict_named(cfg: DictConfig) -> dict:
+    """Stage ``predict_named``: heatmaps of the named maps, the prediction metrics over all
+    parts (``predict.json``) and the paper's Fig. 3 on the named maps."""
     from vnrrt import viz
     from vnrrt.data.heatmaps import read_heatmaps
     from vnrrt.data.reader import Shard
-    from vnrrt.predict import predict
+    from vnrrt.predict import predict_named
 
-    results = predict(cfg)
+    results = predict_named(cfg)
     write_json(f"{cfg.paths.metrics}/predict.json", results)
     named = Shard(cfg.paths.named_maps)
     ids = named.instances()
-    maps = {name: read_heatmaps(f"{cfg.paths.heatmaps}/{name}.npz")["named"] for name in results}
+    maps = read_heatmaps(cfg.paths.named_heatmaps)["maps"]
     viz.save_heatmaps(
         f"{cfg.paths.figures}/heatmaps.png",
         [named.grid(named.instance(i)["map_index"]) for i in ids],
@@ -84,3 +95,19 @@ def run_predict(cfg: DictConfig) -> dict:
         titles=named.meta.get("names"),
     )  # fmt: skip
     return results
+
+
+def run_trials_part(cfg: DictConfig, part: int) -> int:
+    """Stage ``trials@<part>``: part ``part`` of the evaluation trials
+    (:func:`vnrrt.evaluation.stage.run_trials_part`)."""
+    from vnrrt.evaluation.stage import run_trials_part as run
+
+    return run(cfg, part)
+
+
+# Stages with parts: name -> (entry point taking (cfg, part id), config key of the part ids).
+PART_STAGES: dict[str, tuple[Callable[[DictConfig, int], object], str]] = {
+    "shard": (run_shard, "scale.shards"),
+    "predict": (run_predict_part, "predict.parts"),
+    "trials": (run_trials_part, "eval.parts"),
+}

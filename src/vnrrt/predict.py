@@ -1,12 +1,17 @@
 """Predict heatmaps of the trained networks for the evaluation instances.
 
-For each network of ``predict.networks`` (checkpoint ``<paths.models>/<name>.ckpt``): the
-positive-class probability maps of the five named maps and of ``predict.test_instances``
-evaluation instances of the test split (:func:`vnrrt.data.datamodule.evaluation_keys`), written
-as float16 to ``<paths.heatmaps>/<name>.npz`` (format: :mod:`vnrrt.data.heatmaps`). The input
-is rendered as in training (the checkpoint's record). Also measured on the test instances: the
-heatmap metrics of :mod:`vnrrt.model.metrics` (mass near the vertices and the path against a
-uniform map, vertex recall) and the inference time per map.
+The networks are ``predict.networks`` (checkpoint ``<paths.models>/<name>.ckpt``); the input
+is rendered as in training (the checkpoint's record). The work is split so that it can run
+as shard jobs (:mod:`vnrrt.multirun`) as well as DVC stages, writing the same files
+(format: :mod:`vnrrt.data.heatmaps`):
+
+* :func:`predict_part` (stage ``predict@<k>``): part ``k`` of ``predict.parts`` of the
+  ``predict.test_instances`` evaluation instances of the test split
+  (:func:`vnrrt.data.datamodule.evaluation_keys`) -> ``<paths.heatmaps>/part_<k>.npz``.
+* :func:`predict_named` (stage ``predict_named``): the five named maps ->
+  ``<paths.named_heatmaps>``, and the heatmap metrics of :mod:`vnrrt.model.metrics`
+  (mass near the vertices and the path against a uniform map, vertex recall) over the named
+  maps and over all parts' stored heatmaps, with the inference time per map.
 """
 
 from __future__ import annotations
@@ -21,8 +26,9 @@ import numpy as np
 import torch
 from omegaconf import DictConfig
 
+from vnrrt.config import ConfigError, check_parts
 from vnrrt.data.datamodule import InstanceDataset, evaluation_keys, verified_files
-from vnrrt.data.heatmaps import write_heatmaps
+from vnrrt.data.heatmaps import part_file, part_rows, read_parts, write_heatmaps
 from vnrrt.data.reader import Shard
 from vnrrt.model.checkpoint import load_network
 from vnrrt.model.metrics import metric_collection
@@ -37,30 +43,46 @@ def pick_device(device: str) -> torch.device:
     return torch.device(device)
 
 
-@torch.inference_mode()
-def predict_dataset(net: torch.nn.Module, data: InstanceDataset, batch_size: int,
-                    device: torch.device, radius: float = 3.0,
-                    tau: float = 0.5) -> tuple[np.ndarray, dict[str, float], float]:  # fmt: skip
-    """Probabilities ``(N, S, S)`` float16 of ``data``'s instances, their heatmap metrics
-    (within ``radius`` px, recall at ``tau``) and the inference seconds per map (network only,
-    bf16 autocast on CUDA)."""
-    net = net.to(device)
-    metrics = metric_collection(radius, tau, with_target=False)
-    autocast = torch.autocast("cuda", torch.bfloat16) if device.type == "cuda" else None
-    out, seconds = [], 0.0
+def _batches(data: InstanceDataset, batch_size: int):
+    """Stacked item dicts of ``data`` in order, ``batch_size`` items at a time."""
     for start in range(0, len(data), batch_size):
         items = [data[i] for i in range(start, min(start + batch_size, len(data)))]
-        batch = {k: torch.stack([it[k] for it in items]) for k in items[0]}
+        yield {k: torch.stack([it[k] for it in items]) for k in items[0]}
+
+
+@torch.inference_mode()
+def predict_dataset(net: torch.nn.Module, data: InstanceDataset, batch_size: int,
+                    device: torch.device) -> tuple[np.ndarray, float]:  # fmt: skip
+    """Probabilities ``(N, S, S)`` float16 of ``data``'s instances and the inference seconds
+    per map (network only, bf16 autocast on CUDA)."""
+    net = net.to(device).eval()
+    autocast = torch.autocast("cuda", torch.bfloat16) if device.type == "cuda" else None
+    out, seconds = [], 0.0
+    for batch in _batches(data, batch_size):
         image = batch["image"].to(device)
         tick = time.perf_counter()
         with autocast or contextlib.nullcontext():
             probs = net(image).float().softmax(dim=1)[:, 1]  # (B, S, S)
         probs = probs.cpu()
         seconds += time.perf_counter() - tick
-        metrics.update(preds=probs, vertices=batch["vertices"], path=batch["path"])
         out.append(probs.numpy().astype(np.float16))
-    values = {k: float(v) for k, v in metrics.compute().items()}
-    return np.concatenate(out), values, seconds / max(len(data), 1)
+    size = data[0]["image"].shape[-1] if len(data) else 0
+    maps = np.concatenate(out) if out else np.zeros((0, size, size), np.float16)
+    return maps, seconds / max(len(data), 1)
+
+
+def heatmap_metrics(maps: np.ndarray, data: InstanceDataset, batch_size: int = 64,
+                    radius: float = 3.0, tau: float = 0.5) -> dict[str, float]:  # fmt: skip
+    """Heatmap metrics (:func:`vnrrt.model.metrics.heatmap_metrics`, within ``radius`` px,
+    recall at ``tau``) of ``maps`` ``(N, S, S)`` against ``data``'s A* paths and vertices."""
+    metrics = metric_collection(radius, tau, with_target=False)
+    row = 0
+    for batch in _batches(data, batch_size):
+        n = len(batch["path"])
+        preds = torch.from_numpy(maps[row : row + n].astype(np.float32))
+        metrics.update(preds=preds, vertices=batch["vertices"], path=batch["path"])
+        row += n
+    return {k: float(v) for k, v in metrics.compute().items()}
 
 
 def _dataset(files, shard_ids, keys, record: dict) -> InstanceDataset:
@@ -70,33 +92,72 @@ def _dataset(files, shard_ids, keys, record: dict) -> InstanceDataset:
                            **record["render"])  # fmt: skip
 
 
-def _sha256(path: Path) -> str:
-    return hashlib.sha256(path.read_bytes()).hexdigest()
-
-
-def predict(cfg: DictConfig) -> dict:
-    """Write the heatmaps of every ``predict.networks`` entry; return their metrics."""
-    p = cfg.predict
-    files = verified_files(cfg.paths.shards, cfg.paths.manifest, list(cfg.scale.shards))
-    positions = evaluation_keys([Shard(f) for f in files], int(p.test_instances))
-    shard_ids = list(cfg.scale.shards)
-    named = Shard(cfg.paths.named_maps)
-    named_keys = np.stack([np.zeros(named.n_instances, np.int64), named.instances()], axis=1)
-    device, results = pick_device(p.device), {}
-    for name in p.networks:
+def _networks(cfg: DictConfig) -> dict[str, tuple[torch.nn.Module, dict, dict]]:
+    """``{name: (network, checkpoint record, file info)}`` of every ``predict.networks``."""
+    out = {}
+    for name in cfg.predict.networks:
         ckpt = Path(cfg.paths.models) / f"{name}.ckpt"
         net, record = load_network(ckpt, name)
-        test_maps, test_metrics, sec = predict_dataset(
-            net, _dataset(files, shard_ids, positions, record), int(p.batch_size), device
-        )
+        sha = hashlib.sha256(ckpt.read_bytes()).hexdigest()
+        info = {"target": record["target"], "checkpoint": str(ckpt), "checkpoint_sha256": sha}
+        out[name] = (net, record, info)
+    return out
+
+
+def _evaluation_positions(cfg: DictConfig) -> tuple[list[Path], list[int], np.ndarray]:
+    """Verified shard files, their ids and the evaluation keys ``(R, 2)`` (file position,
+    instance index)."""
+    shard_ids = [int(s) for s in cfg.scale.shards]
+    files = verified_files(cfg.paths.shards, cfg.paths.manifest, shard_ids)
+    positions = evaluation_keys([Shard(f) for f in files], int(cfg.predict.test_instances))
+    return files, shard_ids, positions
+
+
+def predict_part(cfg: DictConfig, part: int) -> dict:
+    """Heatmaps of every network for evaluation part ``part`` -> ``part_<part>.npz``; returns
+    ``{network: {"instances", "ms_per_map"}}``."""
+    parts = check_parts(cfg.predict.parts, "predict.parts")
+    if part not in parts:
+        raise ConfigError(f"part {part} is not in predict.parts {parts}")
+    files, shard_ids, positions = _evaluation_positions(cfg)
+    positions = positions[part_rows(len(positions), part, len(parts))]
+    keys = np.stack([np.asarray(shard_ids)[positions[:, 0]], positions[:, 1]], axis=1)
+    device, maps, meta = pick_device(cfg.predict.device), {}, {}
+    for name, (net, record, info) in _networks(cfg).items():
+        data = _dataset(files, shard_ids, positions, record)
+        maps[name], sec = predict_dataset(net, data, int(cfg.predict.batch_size), device)
+        meta[name] = {**info, "ms_per_map": 1e3 * sec, "device": device.type}
+    write_heatmaps(part_file(cfg.paths.heatmaps, part), keys, maps, networks=meta,
+                   part=part, parts=len(parts))  # fmt: skip
+    log.info("part %d/%d: %d instances x %d networks", part, len(parts), len(keys), len(maps))
+    return {n: {"instances": len(keys), "ms_per_map": m["ms_per_map"]} for n, m in meta.items()}
+
+
+def predict_named(cfg: DictConfig) -> dict:
+    """Heatmaps of every network for the named maps -> ``paths.named_heatmaps``; returns the metrics
+    ``{network: {"named/<metric>", "test/<metric>", "test_instances", "ms_per_map"}}``, the
+    ``test/`` ones over the stored heatmaps of every part (so independent of the split)."""
+    named = Shard(cfg.paths.named_maps)
+    named_keys = np.stack([np.zeros(named.n_instances, np.int64), named.instances()], axis=1)
+    files, shard_ids, positions = _evaluation_positions(cfg)
+    parts = read_parts(cfg.paths.heatmaps, check_parts(cfg.predict.parts, "predict.parts"))
+    want = np.stack([np.asarray(shard_ids)[positions[:, 0]], positions[:, 1]], axis=1)
+    if not np.array_equal(parts["keys"], want):
+        raise ConfigError(f"heatmap parts in {cfg.paths.heatmaps} are not the evaluation "
+                          f"instances of this config (re-run `dvc repro predict`)")  # fmt: skip
+    device, maps, meta, results = pick_device(cfg.predict.device), {}, {}, {}
+    for name, (net, record, info) in _networks(cfg).items():
         named_data = _dataset([named.file], [-1], named_keys, record)
-        named_maps, named_metrics, _ = predict_dataset(net, named_data, int(p.batch_size), device)
-        test_keys = np.stack([np.asarray(shard_ids)[positions[:, 0]], positions[:, 1]], axis=1)
-        write_heatmaps(Path(cfg.paths.heatmaps) / f"{name}.npz", named_maps, test_maps,
-                       test_keys, network=name, target=record["target"],
-                       checkpoint=str(ckpt), checkpoint_sha256=_sha256(ckpt))  # fmt: skip
-        results[name] = {**{f"test/{k}": v for k, v in test_metrics.items()},
+        maps[name], _ = predict_dataset(net, named_data, int(cfg.predict.batch_size), device)
+        meta[name] = info
+        named_metrics = heatmap_metrics(maps[name], named_data)
+        test = heatmap_metrics(parts["maps"][name], _dataset(files, shard_ids, positions, record))
+        ms_parts = [m["networks"][name]["ms_per_map"] for m in parts["meta"]]
+        ms = float(np.average(ms_parts, weights=parts["counts"])) if len(positions) else 0.0
+        results[name] = {**{f"test/{k}": v for k, v in test.items()},
                          **{f"named/{k}": v for k, v in named_metrics.items()},
-                         "test_instances": len(test_maps), "ms_per_map": 1e3 * sec}  # fmt: skip
+                         "test_instances": len(positions), "ms_per_map": ms}  # fmt: skip
         log.info("%s: %s", name, results[name])
+    keys = np.stack([np.full(named.n_instances, -1), named.instances()], axis=1)
+    write_heatmaps(cfg.paths.named_heatmaps, keys, maps, networks=meta)
     return results

@@ -4,6 +4,11 @@ per-trial table, summary metrics (``dvc metrics``) and curves (``dvc plots``).
 Planner configurations come from ``eval.planners``; M-VNRRT* runs once per threshold in
 ``planner.taus`` plus ``planner.tau`` (so ``dvc exp run -S planner.tau=0.7`` adds one).
 Trial counts and the number of random maps come from the ``eval`` section (set per scale).
+
+The trials are split into the parts of ``eval.parts`` (:func:`vnrrt.evaluation.trials.part_jobs`)
+so that they can run as shard jobs (:mod:`vnrrt.multirun`) as well as DVC stages: part ``k``
+writes ``<paths.trials>/part_<k>.csv`` (stage ``trials@<k>``) and stage ``evaluate`` merges
+the parts back into the protocol's table, row ``seq`` at row ``seq``, whatever the split.
 """
 
 from __future__ import annotations
@@ -16,15 +21,17 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from vnrrt.config import ConfigError
-from vnrrt.evaluation.instances import load_eval_instances
+from vnrrt.config import ConfigError, check_parts
+from vnrrt.evaluation.instances import instance_kinds, load_eval_instances
 from vnrrt.evaluation.report import check_trials
 from vnrrt.evaluation.stats import summarize
 from vnrrt.evaluation.trials import (
     CONVERGENCE_FACTORS,
     PlannerSpec,
     convergence_column,
-    run_trials,
+    part_jobs,
+    run_jobs,
+    trial_jobs,
 )
 from vnrrt.planners import PlannerConfig
 from vnrrt.planners.reference import any_angle_length
@@ -52,8 +59,10 @@ class EvalConfig:
     # also run the optimal trials to within 1 + eps of the any-angle length (stricter than
     # the paper's A* reference; reported in an extra table)
     any_angle: bool = True
+    parts: list[int] = field(default_factory=lambda: [0])  # trial parts: [0, 1, ..., K-1]
 
     def validate(self) -> None:
+        check_parts(self.parts, "eval.parts")
         for name in ("named_initial", "named_optimal", "random_maps", "random_initial",
                      "random_optimal"):  # fmt: skip
             if getattr(self, name) < 0:
@@ -134,13 +143,52 @@ def convergence_curves(trials: pd.DataFrame, eps: float) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def evaluate(instances_args: dict, ev: EvalConfig, planner: PlannerConfig,
-             targets: dict[str, str], seed: int, workers: int) -> pd.DataFrame:  # fmt: skip
-    """Run every trial; ``instances_args`` are :func:`load_eval_instances` arguments."""
-    instances = with_references(load_eval_instances(**instances_args), planner.reference)
-    specs = planner_specs(ev, planner, targets)
-    log.info("%d instances x %d planner configurations", len(instances), len(specs))
-    return run_trials(instances, specs, trial_counts(ev), seed, workers, planner)
+def protocol_jobs(instances_args: dict, ev: EvalConfig, planner: PlannerConfig,
+                  targets: dict[str, str]) -> list:  # fmt: skip
+    """Every :class:`~vnrrt.evaluation.trials.TrialJob` of the protocol, in canonical order;
+    ``instances_args`` are :func:`load_eval_instances` arguments."""
+    kinds = instance_kinds(instances_args["named_maps"], instances_args["n_random"])
+    return trial_jobs(kinds, planner_specs(ev, planner, targets), trial_counts(ev))
+
+
+def evaluate_part(instances_args: dict, ev: EvalConfig, planner: PlannerConfig,
+                  targets: dict[str, str], seed: int, workers: int,
+                  part: int = 0) -> pd.DataFrame:  # fmt: skip
+    """The trials of part ``part`` of ``ev.parts`` (all of them with one part)."""
+    jobs = part_jobs(protocol_jobs(instances_args, ev, planner, targets), part, len(ev.parts))
+    needed = {job.instance for job in jobs}
+    loaded = load_eval_instances(**instances_args, only=needed)
+    instances = dict(zip(loaded, with_references(list(loaded.values()), planner.reference)))
+    log.info("part %d/%d: %d trial jobs on %d instances", part, len(ev.parts), len(jobs),
+             len(instances))  # fmt: skip
+    return run_jobs(jobs, instances, seed, workers, planner)
+
+
+def trials_file(directory: str | Path, part: int) -> Path:
+    """``<directory>/part_<part>.csv``: the trial table of part ``part``."""
+    return Path(directory) / f"part_{part}.csv"
+
+
+def read_trials(
+    directory: str | Path, parts: list[int], expected: int | None = None
+) -> pd.DataFrame:
+    """The trial tables of ``parts`` merged in ``seq`` order; ``ValueError`` naming the
+    directory unless their rows are exactly ``seq`` 0 .. N-1 (``N = expected`` if given)."""
+    missing = [
+        str(trials_file(directory, k)) for k in parts if not trials_file(directory, k).is_file()
+    ]
+    if missing:
+        raise FileNotFoundError(f"trial tables {missing} do not exist (run `dvc repro evaluate`)")
+    tables = [pd.read_csv(trials_file(directory, k)) for k in parts]
+    table = pd.concat(tables, ignore_index=True).sort_values(
+        "seq", kind="stable", ignore_index=True
+    )
+    n = len(table) if expected is None else expected
+    if not np.array_equal(table["seq"].to_numpy(), np.arange(n)):
+        raise ValueError(f"trial tables in {directory} (parts {list(parts)}) do not hold rows "
+                         f"0..{n - 1} of one protocol: a part is missing, repeated or from "
+                         f"another config (re-run `dvc repro evaluate`)")  # fmt: skip
+    return table
 
 
 def write_table(table: pd.DataFrame, path: str | Path) -> None:

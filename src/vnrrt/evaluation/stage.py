@@ -1,6 +1,8 @@
-"""Entry points of the ``evaluate`` and ``report`` DVC stages, and their MLflow runs.
+"""Entry points of the ``trials@<part>``, ``evaluate`` and ``report`` DVC stages, and their
+MLflow runs.
 
-``evaluate`` writes the per-trial table, summary metrics and convergence curves;
+``trials@<k>`` runs part ``k`` of the protocol's trials into ``<paths.trials>/part_<k>.csv``;
+``evaluate`` merges the parts and writes the summary metrics and convergence curves;
 ``report`` turns the table into ``paper_comparison.md`` and the figures, and logs one
 MLflow run per planner configuration nested under a parent ``evaluation`` run, with the
 report and figures as the parent's artifacts.
@@ -16,13 +18,16 @@ import pandas as pd
 from omegaconf import DictConfig
 
 from vnrrt import tracking
-from vnrrt.config import ScaleConfig, section
+from vnrrt.config import ConfigError, ScaleConfig, check_parts, section
 from vnrrt.data.manifest import write_json
 from vnrrt.evaluation.evaluate import (
     EvalConfig,
     convergence_curves,
-    evaluate,
+    evaluate_part,
+    protocol_jobs,
+    read_trials,
     summary_metrics,
+    trials_file,
     write_table,
 )
 from vnrrt.evaluation.report import build_report, check_trials, load_paper_tables
@@ -32,17 +37,41 @@ from vnrrt.planners import PlannerConfig
 log = logging.getLogger(__name__)
 
 
-def run_evaluate(cfg: DictConfig) -> dict:
-    """Stage ``evaluate``: every trial of the protocol -> ``paths.eval`` files."""
+def _protocol(cfg: DictConfig) -> tuple[EvalConfig, PlannerConfig, dict, dict]:
+    """The ``eval`` and ``planner`` sections, network -> heatmap source, and the
+    :func:`~vnrrt.evaluation.instances.load_eval_instances` arguments of ``cfg``."""
     ev = section(cfg, "eval", EvalConfig)
     planner = section(cfg, "planner", PlannerConfig)
     scale = section(cfg, "scale", ScaleConfig)
     targets = {name: cfg.networks[name].target for name in cfg.networks}
-    heat = {targets[n]: f"{cfg.paths.heatmaps}/{n}.npz" for n in set(ev.networks.values())}
+    sources = {targets[n]: n for n in sorted(set(ev.networks.values()))}
     args = dict(named_maps=cfg.paths.named_maps, shards_dir=cfg.paths.shards,
-                shard_ids=scale.shards, heatmap_files=heat, n_random=ev.random_maps)  # fmt: skip
-    trials = evaluate(args, ev, planner, targets, int(cfg.seed), int(cfg.get("workers", 0)))
-    write_table(trials, cfg.paths.trials)
+                shard_ids=scale.shards, named_heatmaps=cfg.paths.named_heatmaps,
+                heatmaps_dir=cfg.paths.heatmaps,
+                parts=check_parts(cfg.predict.parts, "predict.parts"), sources=sources,
+                n_random=ev.random_maps)  # fmt: skip
+    return ev, planner, targets, args
+
+
+def run_trials_part(cfg: DictConfig, part: int) -> int:
+    """Stage ``trials@<part>``: the trials of part ``part`` of ``eval.parts`` ->
+    ``<paths.trials>/part_<part>.csv``; returns the number of trials."""
+    ev, planner, targets, args = _protocol(cfg)
+    if part not in ev.parts:
+        raise ConfigError(f"part {part} is not in eval.parts {ev.parts}")
+    table = evaluate_part(
+        args, ev, planner, targets, int(cfg.seed), int(cfg.get("workers", 0)), part
+    )
+    write_table(table, trials_file(cfg.paths.trials, part))
+    return len(table)
+
+
+def run_evaluate(cfg: DictConfig) -> dict:
+    """Stage ``evaluate``: the parts' trials merged -> summary metrics (``eval.json``) and
+    convergence curves; checks that the parts hold every trial of this config's protocol."""
+    ev, planner, targets, args = _protocol(cfg)
+    expected = sum(job.count for job in protocol_jobs(args, ev, planner, targets))
+    trials = read_trials(cfg.paths.trials, ev.parts, expected)
     metrics = summary_metrics(trials)
     write_json(f"{cfg.paths.metrics}/eval.json", metrics)
     write_table(convergence_curves(trials, planner.eps), f"{cfg.paths.plots}/convergence.csv")
@@ -65,7 +94,7 @@ def run_report(cfg: DictConfig) -> Path:
     """Stage ``report``: ``paper_comparison.md``, Fig. 5 and convergence figures, MLflow."""
     from vnrrt import viz
 
-    trials = pd.read_csv(cfg.paths.trials)
+    trials = read_trials(cfg.paths.trials, section(cfg, "eval", EvalConfig).parts)
     paper = load_paper_tables(cfg.paths.paper_tables)
     out = Path(cfg.paths.report)
     text = build_report(trials, paper)
