@@ -18,7 +18,7 @@ Without a GPU the GPU rates are assumptions (``--gpu-train-img-s``, default the 
 (shards and trials are independent jobs; DDP training assumed linear in GPUs, capped by
 the data loader's cores). Example:
 
-    .venv/bin/python benchmarks/bench_paper_scale.py --cores 64 --gpus 4
+    .venv/bin/python benchmarks/bench_paper_scale.py --setups 16:1,64:4
 """
 
 from __future__ import annotations
@@ -169,8 +169,8 @@ def fmt_time(seconds: float) -> str:
 
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    p.add_argument("--cores", type=int, default=16, help="CPU cores of the target setup")
-    p.add_argument("--gpus", type=int, default=1, help="GPUs of the target setup")
+    p.add_argument("--setups", default="16:1,64:4,256:8",
+                   help="target setups CORES:GPUS, comma-separated")  # fmt: skip
     p.add_argument("--gpu-train-img-s", type=float, default=1500.0,
                    help="training images/s of one GPU, when none is here to measure")  # fmt: skip
     p.add_argument("--gpu-infer-img-s", type=float, default=4500.0,
@@ -200,16 +200,19 @@ def main() -> None:
     instances = len(cfg.scale.shards) * cfg.scale.maps_per_shard * 144
     train_items = instances * cfg.data.train_fraction * cfg.trainer.max_epochs
     eval_maps = (cfg.predict.test_instances + 5) * len(cfg.predict.networks)
-    c, g = args.cores, args.gpus
-    feed = loader * max(c - g, 1)  # loader workers: the cores not driving a GPU
-    train_rate = min(gpu_train * g, feed)
-    stages = [  # (stage, seconds on this machine (all cores, CPU), seconds on the target)
-        ("shard@* (maps, A* labels)", instances / (labels * here), instances / (labels * c)),
-        ("train_vertexnet + train_nrrtnet", 2 * train_items / cpu["train"],
-         2 * train_items / train_rate),
-        ("predict@* + predict_named", eval_maps / cpu["infer"], eval_maps / (gpu_infer * g)),
-        (f"trials@* ({n_trials:,} planner trials)", hours * 3600 / here, hours * 3600 / c),
-    ]  # fmt: skip
+    setups = [tuple(int(v) for v in item.split(":")) for item in args.setups.split(",")]
+
+    def stage_seconds(c: int, g: int) -> list[float]:
+        """Seconds per stage with ``c`` cores and ``g`` GPUs (``g = 0``: CPU only, torch
+        rates scaled from this machine's cores)."""
+        feed = loader * max(c - g, 1)  # loader workers: the cores not driving a GPU
+        train = min(gpu_train * g, feed) if g else cpu["train"] * c / here
+        infer = gpu_infer * g if g else cpu["infer"] * c / here
+        return [instances / (labels * c), 2 * train_items / train, eval_maps / infer,
+                hours * 3600 / c]  # fmt: skip
+
+    names = ["shard@* (maps, A* labels)", "train_vertexnet + train_nrrtnet",
+             "predict@* + predict_named", f"trials@* ({n_trials:,} planner trials)"]  # fmt: skip
     print(f"measured here ({here} cores): labelling {labels:,.0f} instances/s/core; "
           f"data loader {loader:,.0f} images/s/worker; paper network {cpu['train_gflops']:.0f}"
           f" training GFLOPs/image, CPU train {cpu['train']:.2f} img/s, CPU inference "
@@ -219,16 +222,21 @@ def main() -> None:
     need = gpu_train * cpu["train_gflops"] / 1e3
     print(f"GPU: train {gpu_train:,.0f} img/s, inference {gpu_infer:,.0f} img/s per GPU "
           f"({gpu_note}); {gpu_train:,.0f} img/s needs {need:,.0f} TFLOP/s = "
-          f"{100 * need / H100_BF16_DENSE_TFLOPS:.0f}% of an H100's dense bf16 peak; "
-          f"{max(c - g, 1)} loader workers feed {feed:,.0f} img/s")  # fmt: skip
+          f"{100 * need / H100_BF16_DENSE_TFLOPS:.0f}% of an H100's dense bf16 peak; one "
+          f"GPU needs {gpu_train / loader:.0f} loader workers")  # fmt: skip
     if borrowed:
         print(f"no trials of {borrowed} in the table: RRT*'s rate used for them")
-    print(f"\n| stage | this machine ({here} cores, no GPU) | {c} cores, {g} GPU(s) | ratio |")
-    print("| --- | --- | --- | --- |")
-    for name, base, target in stages:
-        print(f"| {name} | {fmt_time(base)} | {fmt_time(target)} | {base / target:,.0f}x |")
-    total = sum(s[2] for s in stages)
-    print(f"| total | {fmt_time(sum(s[1] for s in stages))} | {fmt_time(total)} | |")
+    columns = [(here, 0), *setups]
+    table_s = [stage_seconds(c, g) for c, g in columns]
+    heads = [f"{c} cores" + (f", {g} GPU" if g else " (this machine)") for c, g in columns]
+    print("\n| stage | " + " | ".join(heads) + " |")
+    print("| --- |" + " --- |" * len(columns))
+    for k, name in enumerate(names):
+        print(f"| {name} | " + " | ".join(fmt_time(col[k]) for col in table_s) + " |")
+    totals = [sum(col) for col in table_s]
+    print("| total | " + " | ".join(fmt_time(t) for t in totals) + " |")
+    print("| ratio to this machine | " + " | ".join(f"{totals[0] / t:,.0f}x" for t in totals)
+          + " |")  # fmt: skip
 
 
 if __name__ == "__main__":

@@ -232,3 +232,31 @@ def test_random_maps_all_planners(planner, seed):
     best = plan(g, s, e, planner, stop="optimal", reference="any_angle", seed=seed, **kw)
     check_path(g, best, s, e)
     assert best.cost <= 1.01 * tight <= 1.01 * astar_length(g, s, e)
+
+
+@pytest.mark.parametrize("spacing", [0.0, 0.5])
+def test_min_spacing_stops_nodes_piling_up_under_a_concentrated_heatmap(grid, spacing):
+    """M-VNRRT* on a heatmap with one hot pixel draws half its samples inside that pixel.
+    With ``min_spacing`` s, a node added from such a sample is at least s from every node,
+    so the pixel holds at most 9 nodes for s = 0.5 (3 x 3 at spacing 0.5); without it,
+    hundreds pile up there."""
+    hot = np.zeros(grid.shape)
+    hx, hy = 20, 20
+    hot[hy, hx] = 1.0
+    r = plan(grid, (5.5, 5.5), (54.5, 54.5), "m_vnrrt_star", heatmap=hot, tau=0.5,
+             stop="optimal", reference_length=1.0, seed=3, keep_tree=True,
+             min_spacing=spacing, max_iterations=4000)  # fmt: skip  (runs all 4,000)
+    pts = r.tree_points
+    inside = (np.floor(pts[:, 0]) == hx) & (np.floor(pts[:, 1]) == hy)
+    if spacing > 0:
+        assert inside.sum() <= 9
+        near = pts[inside]
+        gaps = np.hypot(*(near[:, None] - near[None]).transpose(2, 0, 1))
+        assert (gaps[~np.eye(len(near), dtype=bool)] >= spacing - 1e-9).all()
+    else:
+        assert inside.sum() > 100
+
+
+def test_min_spacing_must_be_below_the_steer_step(grid):
+    with pytest.raises(PlannerConfigError, match="min_spacing"):
+        plan(grid, (5.5, 5.5), (54.5, 54.5), min_spacing=20.0)

@@ -59,7 +59,7 @@ def _check_endpoint(occ: np.ndarray, point, name: str) -> tuple[float, float]:
 
 
 def _params(cfg: PlannerConfig, occ: np.ndarray, goal, mix: float) -> np.ndarray:
-    params = np.zeros(7)
+    params = np.zeros(8)
     gamma = cfg.gamma
     if gamma is None:  # RRT* bound 2 (1 + 1/d)^(1/d) (free area / unit-ball area)^(1/d), d=2
         gamma = 2.0 * math.sqrt(1.5) * math.sqrt(np.count_nonzero(occ == 0) / math.pi)
@@ -69,6 +69,7 @@ def _params(cfg: PlannerConfig, occ: np.ndarray, goal, mix: float) -> np.ndarray
     params[core.P_GOAL_RADIUS] = cfg.eta if cfg.goal_radius is None else cfg.goal_radius
     params[core.P_GX], params[core.P_GY] = goal
     params[core.P_MIX] = mix
+    params[core.P_MIN_SPACING] = cfg.min_spacing
     return params
 
 

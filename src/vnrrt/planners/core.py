@@ -204,7 +204,7 @@ def near_radius(n, eta, gamma, fixed_radius):
 
 
 # Slots of the float64 ``params`` array given to :func:`grow`.
-P_ETA, P_GAMMA, P_RADIUS, P_GOAL_RADIUS, P_GX, P_GY, P_MIX = range(7)
+P_ETA, P_GAMMA, P_RADIUS, P_GOAL_RADIUS, P_GX, P_GY, P_MIX, P_MIN_SPACING = range(8)
 
 
 @njit(cache=True)
@@ -228,7 +228,7 @@ def grow(
         sx, sy = sample_point(rng, h, w, params[P_MIX], cdf, last)
         p = spatial.nearest(head, bnext, pts, bucket, sx, sy)
         d = math.hypot(sx - pts[p, 0], sy - pts[p, 1])
-        if d <= 0.0:
+        if d <= params[P_MIN_SPACING]:  # a node here would duplicate its nearest node
             continue
         t = min(1.0, eta / d)  # Steer
         x, y = pts[p, 0] + t * (sx - pts[p, 0]), pts[p, 1] + t * (sy - pts[p, 1])
