@@ -160,6 +160,11 @@ def trials_hours(per_trial: pd.Series, ratio: float, cfg) -> tuple[float, int, l
 
 
 def fmt_time(seconds: float) -> str:
+    """Seconds as s / min / h / days, two or three significant figures."""
+    if seconds < 1:
+        return "< 1 s"
+    if seconds > 3 * 86400:
+        return f"{seconds / 86400:.0f} days"
     if seconds < 120:
         return f"{seconds:.0f} s"
     if seconds < 7200:
