@@ -1,4 +1,5 @@
-"""Slow: 2-process DDP training on CPU (gloo), and the train + predict stages under DVC."""
+"""2-process DDP training on CPU (gloo; in the default run, so CI runs it), and, slow, the
+train + predict stages under DVC (test_pipeline's end-to-end smoke run covers them too)."""
 
 import json
 import os
@@ -15,7 +16,6 @@ from vnrrt.config import compose, dump
 from vnrrt.data.heatmaps import read_heatmaps, read_parts
 from vnrrt.model.checkpoint import load_network
 
-pytestmark = pytest.mark.slow
 REPO = Path(__file__).resolve().parents[1]
 
 
@@ -43,6 +43,7 @@ def test_ddp_trains_on_two_cpu_processes(small_data, tmp_path):
     assert len(runs) == 1  # rank 0 only
 
 
+@pytest.mark.slow
 def test_dvc_repro_trains_both_networks_and_predicts(tmp_path):
     copy_pipeline(REPO, tmp_path)
     run(["git", "init", "-q"], tmp_path)
