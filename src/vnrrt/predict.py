@@ -104,13 +104,16 @@ def _networks(cfg: DictConfig) -> dict[str, tuple[torch.nn.Module, dict, dict]]:
     return out
 
 
-def _evaluation_positions(cfg: DictConfig) -> tuple[list[Path], list[int], np.ndarray]:
-    """Verified shard files, their ids and the evaluation keys ``(R, 2)`` (file position,
-    instance index)."""
+def _evaluation_positions(
+    cfg: DictConfig,
+) -> tuple[list[Path], list[int], np.ndarray, np.ndarray]:
+    """Verified shard files, their ids, the evaluation instances ``(R, 2)`` as (file
+    position, instance index) and as the keys of the heatmap files (shard id, instance)."""
     shard_ids = [int(s) for s in cfg.scale.shards]
     files = verified_files(cfg.paths.shards, cfg.paths.manifest, shard_ids)
     positions = evaluation_keys([Shard(f) for f in files], int(cfg.predict.test_instances))
-    return files, shard_ids, positions
+    keys = np.stack([np.asarray(shard_ids)[positions[:, 0]], positions[:, 1]], axis=1)
+    return files, shard_ids, positions, keys
 
 
 def predict_part(cfg: DictConfig, part: int) -> dict:
@@ -119,9 +122,9 @@ def predict_part(cfg: DictConfig, part: int) -> dict:
     parts = check_parts(cfg.predict.parts, "predict.parts")
     if part not in parts:
         raise ConfigError(f"part {part} is not in predict.parts {parts}")
-    files, shard_ids, positions = _evaluation_positions(cfg)
-    positions = positions[part_rows(len(positions), part, len(parts))]
-    keys = np.stack([np.asarray(shard_ids)[positions[:, 0]], positions[:, 1]], axis=1)
+    files, shard_ids, positions, keys = _evaluation_positions(cfg)
+    rows = part_rows(len(positions), part, len(parts))
+    positions, keys = positions[rows], keys[rows]
     device, maps, meta = pick_device(cfg.predict.device), {}, {}
     for name, (net, record, info) in _networks(cfg).items():
         data = _dataset(files, shard_ids, positions, record)
@@ -139,10 +142,9 @@ def predict_named(cfg: DictConfig) -> dict:
     ``test/`` ones over the stored heatmaps of every part (so independent of the split)."""
     named = Shard(cfg.paths.named_maps)
     named_keys = np.stack([np.zeros(named.n_instances, np.int64), named.instances()], axis=1)
-    files, shard_ids, positions = _evaluation_positions(cfg)
+    files, shard_ids, positions, keys = _evaluation_positions(cfg)
     parts = read_parts(cfg.paths.heatmaps, check_parts(cfg.predict.parts, "predict.parts"))
-    want = np.stack([np.asarray(shard_ids)[positions[:, 0]], positions[:, 1]], axis=1)
-    if not np.array_equal(parts["keys"], want):
+    if not np.array_equal(parts["keys"], keys):
         raise ConfigError(f"heatmap parts in {cfg.paths.heatmaps} are not the evaluation "
                           f"instances of this config (re-run `dvc repro predict`)")  # fmt: skip
     device, maps, meta, results = pick_device(cfg.predict.device), {}, {}, {}
@@ -158,6 +160,6 @@ def predict_named(cfg: DictConfig) -> dict:
                          **{f"named/{k}": v for k, v in named_metrics.items()},
                          "test_instances": len(positions), "ms_per_map": ms}  # fmt: skip
         log.info("%s: %s", name, results[name])
-    keys = np.stack([np.full(named.n_instances, -1), named.instances()], axis=1)
-    write_heatmaps(cfg.paths.named_heatmaps, keys, maps, networks=meta)
+    named_file_keys = np.stack([np.full(named.n_instances, -1), named.instances()], axis=1)
+    write_heatmaps(cfg.paths.named_heatmaps, named_file_keys, maps, networks=meta)
     return results

@@ -172,8 +172,9 @@ def trials_file(directory: str | Path, part: int) -> Path:
 def read_trials(
     directory: str | Path, parts: list[int], expected: int | None = None
 ) -> pd.DataFrame:
-    """The trial tables of ``parts`` merged in ``seq`` order; ``ValueError`` naming the
-    directory unless their rows are exactly ``seq`` 0 .. N-1 (``N = expected`` if given)."""
+    """The trial tables of ``parts`` merged in ``seq`` order. ``FileNotFoundError`` naming
+    the missing parts, ``ValueError`` naming the directory unless the rows are exactly
+    ``seq`` 0 .. N-1 (``N = expected`` if given)."""
     missing = [
         str(trials_file(directory, k)) for k in parts if not trials_file(directory, k).is_file()
     ]
