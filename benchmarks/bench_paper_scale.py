@@ -32,13 +32,14 @@ import numpy as np
 import pandas as pd
 import torch
 
+import bench_model  # benchmarks/ is on sys.path when this script runs
 from vnrrt.config import DataConfig, LabelsConfig, compose, section
 from vnrrt.data.build import build_shard
 from vnrrt.data.datamodule import InstanceDataset
 from vnrrt.data.shards import shard_file
 from vnrrt.evaluation.evaluate import EvalConfig, planner_specs, read_trials, trial_counts
 from vnrrt.evaluation.report import check_trials
-from vnrrt.model import FocalLoss, VertexNet
+from vnrrt.model import VertexNet
 from vnrrt.parallel import n_workers
 from vnrrt.planners import PlannerConfig, plan, warmup
 from vnrrt.planners.reference import any_angle_length
@@ -66,44 +67,20 @@ def loader_rate(shard: Path, n: int) -> float:
 
 
 def network_rates(batch: int, steps: int, device: torch.device) -> dict[str, float]:
-    """Training images/s and inference images/s of the paper network on ``device`` (bf16 and
-    channels_last on CUDA), and its training GFLOPs per image (forward + backward)."""
+    """Training and inference images/s of the paper network on ``device`` (bf16 and
+    channels_last on CUDA; :func:`bench_model.bench`), and its training GFLOPs per image
+    (forward + backward)."""
     from torch.utils.flop_counter import FlopCounterMode
 
-    gpu = device.type == "cuda"
-    fmt = torch.channels_last if gpu else torch.contiguous_format
-    net = VertexNet("resnet34", weights=None, freeze_encoder=False).to(device, memory_format=fmt)
+    net = VertexNet("resnet34", weights=None, freeze_encoder=False).to(device)
     with FlopCounterMode(display=False) as flops:
         net(torch.rand(1, 3, 200, 200, device=device)).sum().backward()
-    x = torch.rand(batch, 3, 200, 200, device=device).to(memory_format=fmt)
-    y = (torch.rand(batch, 200, 200, device=device) < 0.001).long()
-    loss_fn, opt = FocalLoss(gamma=2.0), torch.optim.AdamW(net.parameters(), lr=1e-4)
-    autocast = torch.autocast(device.type, torch.bfloat16, enabled=gpu)
-
-    def train() -> None:
-        with autocast:
-            loss = loss_fn(net(x), y)
-        opt.zero_grad(set_to_none=True)
-        loss.backward()
-        opt.step()
-
-    @torch.inference_mode()
-    def infer() -> None:
-        with autocast:
-            net(x).softmax(1)
-
-    rates = {}
-    for name, step in (("train", train), ("infer", infer)):
-        step()
-        if gpu:
-            torch.cuda.synchronize()
-        start = time.perf_counter()
-        for _ in range(steps):
-            step()
-        if gpu:
-            torch.cuda.synchronize()
-        rates[name] = batch * steps / (time.perf_counter() - start)
-    return {**rates, "train_gflops": flops.get_total_flops() / 1e9}
+    gpu = device.type == "cuda"
+    run = argparse.Namespace(encoder="resnet34", width=1.0, batch=batch, size=200, steps=steps,
+                             warmup=1, compile=False, bf16=gpu, channels_last=gpu)  # fmt: skip
+    rates = bench_model.bench(run, device)
+    return {"train": rates["train_images_per_s"], "infer": rates["infer_images_per_s"],
+            "train_gflops": flops.get_total_flops() / 1e9}  # fmt: skip
 
 
 def trial_seconds(trials: pd.DataFrame) -> pd.Series:
