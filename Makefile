@@ -33,8 +33,8 @@ format: $(STAMP)  ## apply ruff fixes and formatting
 	$(BIN)/ruff check --fix .
 	$(BIN)/ruff format .
 
-params: $(STAMP)  ## write params.yaml from conf/ (the default composition, as DVC does)
-	$(BIN)/python -m vnrrt.config > params.yaml
+params: $(STAMP)  ## write params.yaml from conf/ (the default composition, as DVC does; validated)
+	$(BIN)/python -m vnrrt.params --out params.yaml
 
 repro: $(STAMP)  ## run the whole pipeline (dvc repro) at the default scale
 	$(BIN)/dvc repro

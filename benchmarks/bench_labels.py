@@ -21,9 +21,10 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import dijkstra
 from skimage.graph import MCP_Geometric
 
-from vnrrt.config import DataConfig, LabelsConfig
 from vnrrt.data.build import build_shard, make_map
+from vnrrt.data.config import LabelsConfig
 from vnrrt.grid import MOVE_COSTS, MOVES
+from vnrrt.maps.config import DataConfig
 from vnrrt.maps.generate import generate_map, map_rng
 from vnrrt.search import astar, move_masks
 

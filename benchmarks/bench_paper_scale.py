@@ -33,12 +33,14 @@ import pandas as pd
 import torch
 
 import bench_model  # benchmarks/ is on sys.path when this script runs
-from vnrrt.config import DataConfig, LabelsConfig, compose, section
+from vnrrt.config import compose, section
 from vnrrt.data.build import build_shard
+from vnrrt.data.config import LabelsConfig
 from vnrrt.data.datamodule import InstanceDataset
 from vnrrt.data.shards import shard_file
 from vnrrt.evaluation.evaluate import EvalConfig, planner_specs, read_trials, trial_counts
 from vnrrt.evaluation.report import check_trials
+from vnrrt.maps.config import DataConfig
 from vnrrt.model import VertexNet
 from vnrrt.parallel import n_workers
 from vnrrt.planners import PlannerConfig, plan, warmup

@@ -24,10 +24,12 @@ import lightning as L
 import torch
 from hydra.utils import instantiate
 
-from vnrrt.config import DataConfig, LabelsConfig, compose, section
+from vnrrt.config import compose, section
 from vnrrt.data.build import build_shard
+from vnrrt.data.config import LabelsConfig
 from vnrrt.data.manifest import build_manifest
 from vnrrt.data.shards import shard_file
+from vnrrt.maps.config import DataConfig
 from vnrrt.predict import predict_dataset
 
 

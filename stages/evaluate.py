@@ -1,7 +1,7 @@
-"""DVC stage evaluate: merged trials, summary metrics and convergence curves."""
+"""DVC stage evaluate: the trial parts merged, statistics and convergence curves."""
 
 from vnrrt.evaluation.stage import run_evaluate
 from vnrrt.stage_cli import stage_main
 
 if __name__ == "__main__":
-    stage_main(run_evaluate, __doc__)
+    stage_main("evaluate", run_evaluate, __doc__)

@@ -1,7 +1,7 @@
-"""DVC stage predict@<k>: heatmaps of the networks for part k of the evaluation instances."""
+"""DVC stage predict@<k>: heatmaps of the networks for part k of the instances."""
 
-from vnrrt.pipeline import run_predict_part
+from vnrrt.predict.stage import run_predict_part
 from vnrrt.stage_cli import stage_main
 
 if __name__ == "__main__":
-    stage_main(run_predict_part, __doc__, "part", int, "part id (predict.parts)")
+    stage_main("predict", run_predict_part, __doc__, "part", int, "part id (predict.parts)")

@@ -1,7 +1,7 @@
-"""DVC stage report: paper_comparison.md, figures and the MLflow evaluation runs."""
+"""DVC stage report: paper_comparison.md, figures, headline metrics, MLflow runs."""
 
 from vnrrt.evaluation.stage import run_report
 from vnrrt.stage_cli import stage_main
 
 if __name__ == "__main__":
-    stage_main(run_report, __doc__)
+    stage_main("report", run_report, __doc__)

@@ -1,7 +1,7 @@
-"""DVC stage train_<network>: train VertexNet or the NRRT* network (vnrrt.pipeline.run_train)."""
+"""DVC stage train@<network>: train VertexNet or the NRRT* network."""
 
-from vnrrt.pipeline import run_train
 from vnrrt.stage_cli import stage_main
+from vnrrt.training.stage import run_train
 
 if __name__ == "__main__":
-    stage_main(run_train, __doc__, "network", str, "vertexnet or nrrtnet (networks.*)")
+    stage_main("train", run_train, __doc__, "network", str, "vertexnet or nrrtnet")

@@ -4,4 +4,4 @@ from vnrrt.evaluation.stage import run_trials_part
 from vnrrt.stage_cli import stage_main
 
 if __name__ == "__main__":
-    stage_main(run_trials_part, __doc__, "part", int, "part id (eval.parts)")
+    stage_main("trials", run_trials_part, __doc__, "part", int, "part id (eval.parts)")

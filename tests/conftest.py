@@ -53,7 +53,7 @@ def trained(small_data, tmp_path_factory) -> Path:
     """Outputs (``models/vertexnet.ckpt``, ``models/nrrtnet.ckpt``, metrics) of two training
     steps of each network on the 64x64 smoke data."""
     from tests.train_helpers import QUICK, small_cfg
-    from vnrrt.train import train
+    from vnrrt.training.stage import run_train as train
 
     out = tmp_path_factory.mktemp("trained")
     cfg = small_cfg(small_data, out, *QUICK)
@@ -63,6 +63,7 @@ def trained(small_data, tmp_path_factory) -> Path:
 
 
 PIPELINE_FILES = ["dvc.yaml", "conf", "stages", "src", ".dvcignore", "reports/paper/tables.yaml"]
+DVC_FILES = [".dvc/config", ".dvc/plots/series.json"]  # copied after `dvc init`
 
 
 def copy_pipeline(repo: Path, dest: Path) -> Path:
@@ -76,6 +77,13 @@ def copy_pipeline(repo: Path, dest: Path) -> Path:
         else:
             shutil.copy(src, dst)
     return dest
+
+
+def copy_dvc_files(repo: Path, dest: Path) -> None:
+    """After ``dvc init`` in ``dest``: the project's DVC config and plot template."""
+    for name in DVC_FILES:
+        (dest / name).parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy(repo / name, dest / name)
 
 
 @pytest.fixture(scope="session")

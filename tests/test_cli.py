@@ -5,7 +5,8 @@ import numpy as np
 import pytest
 
 from vnrrt.cli import main
-from vnrrt.config import DataConfig, LabelsConfig
+from vnrrt.data.config import LabelsConfig
+from vnrrt.maps.config import DataConfig
 
 
 @pytest.fixture

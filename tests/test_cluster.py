@@ -10,9 +10,11 @@ from pathlib import Path
 import pytest
 
 from tests.conftest import copy_pipeline
-from vnrrt.config import DataConfig, LabelsConfig, ScaleConfig, compose, section
+from vnrrt.config import compose, section
 from vnrrt.data.build import build_shard
+from vnrrt.data.config import LabelsConfig, ScaleConfig
 from vnrrt.data.shards import shard_file
+from vnrrt.maps.config import DataConfig
 
 SMOKE = ["scale=smoke"]
 SHARDS = (0, 1)
@@ -52,8 +54,7 @@ def scratch(tmp_path, repo) -> tuple[Path, dict]:
         DVC_NO_ANALYTICS="1",
     )
     run(["dvc", "init", "--no-scm", "-q"], tmp_path, env)
-    params = run([sys.executable, "-m", "vnrrt.config", *SMOKE], tmp_path, env)
-    (tmp_path / "params.yaml").write_text(params)
+    run([sys.executable, "-m", "vnrrt.params", *SMOKE, "--out", "params.yaml"], tmp_path, env)
     return tmp_path, env
 
 
@@ -66,7 +67,7 @@ def multirun(work: Path, env: dict, *overrides: str) -> str:
 
 def assert_same_shards(work: Path, expected: dict[int, bytes]) -> None:
     for s, data in expected.items():
-        assert shard_file(work / "data" / "shards", s).read_bytes() == data, f"shard {s}"
+        assert shard_file(work / "data/smoke/shards", s).read_bytes() == data, f"shard {s}"
 
 
 def test_joblib_multirun_writes_the_stage_shards_and_dvc_commit_makes_them_current(
@@ -77,6 +78,7 @@ def test_joblib_multirun_writes_the_stage_shards_and_dvc_commit_makes_them_curre
     assert_same_shards(work, expected)
     assert len(list((work / SWEEP).glob("*/.hydra/config.yaml"))) == len(SHARDS)
 
+    run(["dvc", "repro", "validate"], work, env)  # the check every stage depends on
     run(["dvc", "commit", "-f", "shard"], work, env)
     assert "up to date" in run(["dvc", "status", "shard"], work, env)
     out = run(["dvc", "repro", "manifest"], work, env)  # the data stages and their consumer

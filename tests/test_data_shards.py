@@ -6,11 +6,13 @@ import zipfile
 import numpy as np
 import pytest
 
-from vnrrt.config import DataConfig, LabelsConfig
-from vnrrt.data.build import build_named_maps, build_shard, split_of_maps
+from vnrrt.data.build import build_shard, split_of_maps
+from vnrrt.data.build_named import build_named_maps
+from vnrrt.data.config import LabelsConfig
 from vnrrt.data.manifest import build_manifest, verify_manifest
 from vnrrt.data.reader import Shard
 from vnrrt.data.shards import FIELDS, ShardError, read_arrays, shard_file, write_shard
+from vnrrt.maps.config import DataConfig
 from vnrrt.search import astar, path_length, path_vertices
 
 from .test_search_astar import assert_valid_path
@@ -142,7 +144,7 @@ def test_manifest_counts_checksums_and_tamper_detection(shard_dir, tmp_path):
 
 
 def test_an_interrupted_write_leaves_neither_file_nor_temp(tmp_path):
-    from vnrrt.data.shards import atomic_write_bytes
+    from vnrrt.io import atomic_write_bytes
 
     target = tmp_path / "out.bin"
 

@@ -9,14 +9,10 @@ import torch
 from hydra.utils import instantiate
 
 from tests.train_helpers import small_cfg
-from vnrrt.data.datamodule import (
-    EpochShuffle,
-    ShardDataModule,
-    evaluation_keys,
-    evenly_spaced,
-)
+from vnrrt.data.datamodule import EpochShuffle, ShardDataModule
 from vnrrt.data.reader import Shard
 from vnrrt.data.shards import ShardError
+from vnrrt.data.splits import evaluation_keys, evenly_spaced
 from vnrrt.maps.render import class_map
 
 

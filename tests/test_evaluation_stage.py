@@ -1,32 +1,37 @@
-"""The trials, evaluate and report stages on tiny data with oracle heatmaps (no training
-needed): trial parts and their merge, metrics, curves, report, figures and nested MLflow
-runs."""
+"""The instances, trials, evaluate and report stages on tiny data with oracle heatmaps written
+as prediction parts (no training needed), each run with exactly the parameters its dvc.yaml
+entry declares: instances and their exact optima, trial parts and their merge, statistics,
+report sections, figures, headline metrics and nested MLflow runs."""
 
 import copy
 import json
-import os
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import pytest
 
-from vnrrt.config import DataConfig, LabelsConfig, compose
-from vnrrt.data.build import build_named_maps, build_shard
-from vnrrt.data.heatmaps import part_file, write_heatmaps
-from vnrrt.data.reader import Shard
+from vnrrt.config import compose, restrict, stage_params
+from vnrrt.data.build import build_shard
+from vnrrt.data.build_named import build_named_maps
+from vnrrt.data.config import LabelsConfig
+from vnrrt.data.heatmaps import part_file, part_rows, write_heatmaps
+from vnrrt.data.manifest import build_manifest
 from vnrrt.data.shards import shard_file
-from vnrrt.evaluation.evaluate import read_trials, trials_file
-from vnrrt.evaluation.stage import run_evaluate, run_report, run_trials_part
+from vnrrt.evaluation.instances import Instances
+from vnrrt.evaluation.stage import run_evaluate, run_instances, run_report, run_trials_part
+from vnrrt.evaluation.table import TableError, merge_parts, read_table
+from vnrrt.maps.config import DataConfig
+from vnrrt.search import path_mask
 
 NETS = (("vertexnet", "vertex"), ("nrrtnet", "path"))
 # Columns that depend on the seeds only (not on timing): equal whatever the split.
 DETERMINISTIC = [
-    "planner",
-    "tau",
-    "map_set",
-    "map",
+    "seq",
+    "instance",
+    "key",
     "trial",
+    "seed",
     "stop",
     "success",
     "cost",
@@ -34,103 +39,197 @@ DETERMINISTIC = [
     "tree_size",
     "collision_checks",
     "reference_length",
-    "seq",
 ]
 
 
-def oracle(shard: Shard, i: int, target: str) -> np.ndarray:
-    """A perfect network: probability 1 on the target cells, 0.02 elsewhere."""
-    mask = shard.vertex_mask(i) if target == "vertex" else shard.path_mask(i)
-    return np.where(mask, 1.0, 0.02)
+def view(cfg, stage: str, repo: Path):
+    """The parameters stage ``stage`` sees when DVC runs it."""
+    return restrict(cfg, stage_params(stage, repo / "dvc.yaml"))
 
 
 @pytest.fixture(scope="module")
 def cfg(tmp_path_factory, repo):
     tmp = tmp_path_factory.mktemp("eval")
-    build_shard(shard_file(tmp / "shards", 0), 0, 0, 2, DataConfig(), LabelsConfig(), workers=1)
+    build_shard(shard_file(tmp / "shards", 0), 0, 0, 3, DataConfig(), LabelsConfig(), workers=1)
+    build_manifest(tmp / "shards", [0], tmp / "manifest.json")
     build_named_maps(tmp / "named.npz", 200, LabelsConfig())
-    shard, named = Shard(shard_file(tmp / "shards", 0)), Shard(tmp / "named.npz")
-    test = shard.instances("test")[:3]
-    named_maps = {
-        net: np.stack([oracle(named, i, target) for i in range(5)]) for net, target in NETS
-    }
-    write_heatmaps(tmp / "heat_named.npz", np.stack([[-1] * 5, range(5)], axis=1), named_maps)
-    for part, rows in enumerate((test[:1], test[1:])):  # two heatmap parts of 1 and 2
-        maps = {net: np.stack([oracle(shard, i, target) for i in rows]) for net, target in NETS}
-        write_heatmaps(part_file(tmp / "heat", part), np.stack([np.zeros_like(rows), rows], axis=1),
-                       maps)  # fmt: skip
-    over = [f"paths.shards={tmp / 'shards'}", f"paths.named_maps={tmp / 'named.npz'}",
-            f"paths.heatmaps={tmp / 'heat'}", f"paths.named_heatmaps={tmp / 'heat_named.npz'}",
-            f"paths.trials={tmp / 'eval/trials'}", "predict.parts=[0,1]", "eval.parts=[0,1,2]",
-            f"paths.plots={tmp / 'plots'}", f"paths.metrics={tmp / 'metrics'}",
-            f"paths.report={tmp / 'report.md'}", f"paths.figures={tmp / 'figures'}",
-            f"paths.paper_tables={repo / 'reports/paper/tables.yaml'}",
-            f"logger.uri=sqlite:///{tmp / 'mlflow.db'}",
-            f"logger.artifact_location={(tmp / 'artifacts').as_uri()}",
-            "scale=smoke", "scale.shards=[0]", "eval.named_initial=3", "eval.named_optimal=2",
-            "eval.random_maps=3", "planner.max_seconds=5", "workers=1"]  # fmt: skip
-    return compose(over)
+    over = [
+        f"paths.shards={tmp / 'shards'}",
+        f"paths.manifest={tmp / 'manifest.json'}",
+        f"paths.named_maps={tmp / 'named.npz'}",
+        f"paths.instances={tmp / 'inst.npz'}",
+        f"paths.heatmaps={tmp / 'heat'}",
+        f"paths.trials={tmp / 'trials'}",
+        f"paths.trials_table={tmp / 'trials.csv'}",
+        f"paths.summary={tmp / 'summary.json'}",
+        f"paths.plots={tmp / 'plots'}",
+        f"paths.metrics={tmp / 'metrics'}",
+        f"paths.report={tmp / 'report.md'}",
+        f"paths.figures={tmp / 'figures'}",
+        f"paths.paper_tables={repo / 'reports/paper/tables.yaml'}",
+        f"logger.uri=sqlite:///{tmp / 'mlflow.db'}",
+        "predict.parts=[0,1]",
+        "eval.parts=[0,1,2]",
+        "scale=smoke",
+        "scale.shards=[0]",
+        "eval.named_initial=3",
+        "eval.named_optimal=2",
+        "eval.random_maps=3",
+        "planner.max_seconds=5",
+        "workers=1",
+        "stats.bootstrap=200",
+    ]
+    cfg = compose(over)
+    run_instances(view(cfg, "instances", repo))
+    inst = Instances(cfg.paths.instances)
+    for part in (0, 1):  # two parts of oracle "networks": 1 on the target cells, 0.02 elsewhere
+        rows = range(len(inst))[part_rows(len(inst), part, 2)]
+        maps = {
+            net: np.stack(
+                [
+                    np.where(
+                        path_mask(
+                            getattr(inst[i], target if target == "path" else "vertices"), (200, 200)
+                        ),
+                        1.0,
+                        0.02,
+                    )
+                    for i in rows
+                ]
+            )
+            for net, target in NETS
+        }
+        write_heatmaps(part_file(cfg.paths.heatmaps, part), inst.keys[list(rows)], maps)
+    return cfg
 
 
-def test_trial_parts_merge_into_the_protocol_table(cfg):
-    sizes = [run_trials_part(cfg, k) for k in cfg.eval.parts]
-    metrics = run_evaluate(cfg)
-    trials = read_trials(cfg.paths.trials, cfg.eval.parts)
+def test_instances_hold_the_named_maps_then_the_random_test_instances(cfg):
+    inst = Instances(cfg.paths.instances)
+    assert len(inst) == 5 + 3 and inst.kinds == ["named"] * 5 + ["random"] * 3
+    named, random = inst[2], inst[6]
+    assert named.map_set == "map_3" and named.map == "narrow_passage" and named.key == (-1, 2)
+    assert random.map_set == "random" and random.key[0] == 0 and random.cluster >= 0
+    for i in range(len(inst)):
+        x = inst[i]
+        straight = float(np.hypot(*np.subtract(x.goal, x.start)))
+        assert straight - 1e-9 <= x.exact_length <= x.taut_length + 1e-9 <= x.astar_length + 1e-6
+        np.testing.assert_allclose(x.exact_path[[0, -1]], [x.start, x.goal])
+        assert tuple(x.path[0]) == x.start_cell and tuple(x.path[-1]) == x.goal_cell
+
+
+def test_trial_parts_merge_into_the_protocol_table(cfg, repo):
+    sizes = [run_trials_part(view(cfg, f"trials@{k}", repo), k) for k in cfg.eval.parts]
+    summary = run_evaluate(view(cfg, "evaluate", repo))
+    table = read_table(cfg.paths.trials_table)
     n_configs = 3 + len({0.5, 0.9, 0.99, cfg.planner.tau})
-    assert len(trials) == sum(sizes) == n_configs * (5 * (3 + 2 + 2) + 3 * (1 + 1 + 1))
+    assert len(table) == sum(sizes) == n_configs * (5 * (3 + 2 + 2) + 3 * (1 + 1 + 1))
     assert min(sizes) > 0.2 * max(sizes)  # round robin: parts of similar size
-    strict = trials[trials["stop"] == "optimal_any_angle"]
-    loose = trials[trials["stop"] == "optimal"]
-    assert (strict["reference_length"].to_numpy() < loose["reference_length"].to_numpy()).all()
-    assert set(trials["map_set"]) == {"map_1", "map_2", "map_3", "map_4", "map_5", "random"}
-    assert trials["success"].mean() > 0.9
-    on_disk = json.loads(Path(f"{cfg.paths.metrics}/eval.json").read_text())
-    assert on_disk["optimal"]["vnrrt_star"]["map_3"]["success_rate"] == pytest.approx(
-        metrics["optimal"]["vnrrt_star"]["map_3"]["success_rate"])  # fmt: skip
+    strict = table[table["stop"] == "optimal_any_angle"].reset_index()
+    loose = table[table["stop"] == "optimal"].reset_index()
+    assert (strict["reference_length"] < loose["reference_length"]).all()
+    assert set(table["map_set"]) == {"map_1", "map_2", "map_3", "map_4", "map_5", "random"}
+    assert table["success"].mean() > 0.9
+    on_disk = json.loads(Path(cfg.paths.summary).read_text())
+    assert on_disk["cells"]["optimal"]["vnrrt_star"]["map_3"]["time_to_stop"]["n"] == 2
+    assert summary["claims"]["tests"] == 16
+    comp = on_disk["over_rrt_star"]["time_to_stop"]["optimal"]["nrrt_star"]["random"]
+    assert comp["instances"] == 3 and comp["ci_low"] <= comp["speedup"] <= comp["ci_high"]
     curves = pd.read_csv(f"{cfg.paths.plots}/convergence.csv")
-    assert {"planner", "map_set", "factor", "median_time"} <= set(curves.columns)
+    assert {"stop", "planner", "map_set", "factor", "median_time"} <= set(curves.columns)
+    series = pd.read_csv(f"{cfg.paths.plots}/convergence/random.csv")
+    assert list(series.columns) == ["planner", "median_time_ms", "cost_ratio"]
+    assert series["planner"].nunique() == n_configs
 
 
-def test_report_stage_writes_report_figures_and_nested_mlflow_runs(cfg):
+def test_report_stage_writes_report_figures_metrics_and_nested_mlflow_runs(cfg, repo):
     import mlflow
 
-    run_report(cfg)
+    (Path(cfg.paths.metrics)).mkdir(parents=True, exist_ok=True)
+    (Path(cfg.paths.metrics) / "predict.json").write_text(
+        json.dumps(
+            {
+                "vertexnet": {
+                    "ms_per_map": 15.0,
+                    "test/mass_near_vertex": 0.1,
+                    "test/mass_near_vertex_uniform": 0.02,
+                },
+                "nrrtnet": {
+                    "ms_per_map": 14.0,
+                    "test/mass_near_path": 0.2,
+                    "test/mass_near_path_uniform": 0.05,
+                },
+            }
+        )
+    )
+    run_report(view(cfg, "report", repo))
     text = Path(cfg.paths.report).read_text()
-    assert "Table 3" in text and "| vnrrt_star | ours |" in text
-    assert "any-angle" in text
-    for name in ("improvement_initial.png", "improvement_optimal.png", "convergence.png",
-                 "improvement_optimal_any_angle.png"):  # fmt: skip
-        assert os.path.getsize(f"{cfg.paths.figures}/{name}") > 5000
+    for section in (
+        "## The paper's quoted improvements",
+        "## Optimal path lengths",
+        "## Table 3",
+        "exact continuous optimum",
+        "## Planning time and network inference",
+        "Bonferroni",
+        "different map: not comparable",
+        "| NRRT* | ours |",
+        "| M-VNRRT* τ=0.5 | ours |",
+    ):
+        assert section in text, section
+    assert "<br>" not in text
+    figs = Path(cfg.paths.figures) / "evaluation"
+    for name in (
+        "improvement_initial.png",
+        "improvement_optimal.png",
+        "improvement_optimal_any_angle.png",
+        "convergence.png",
+    ):
+        assert (figs / name).stat().st_size > 5000
+    headline = json.loads((Path(cfg.paths.metrics) / "headline.json").read_text())
+    assert sum(headline["verdicts"].values()) == 16
+    assert set(headline["opt_ms"]) == {"rrt", "nrrt", "vnrrt", "m0.5", "m0.9", "m0.99"}
+    assert headline["mass_x_uniform"] == {"vertexnet": 5.0, "nrrtnet": 4.0}
     mlflow.set_tracking_uri(cfg.logger.uri)
     runs = mlflow.search_runs(experiment_names=[cfg.logger.experiment])
     nested = runs["tags.mlflow.parentRunId"].notna()
     parent = runs[~nested]
     assert len(parent) == 1 and parent["tags.kind"].iloc[0] == "evaluation"
+    assert parent["metrics.verdicts/not_reproduced"].notna().all()
+    assert "tags.training_run.vertexnet" in parent
     children = runs[nested]
     assert set(children["tags.mlflow.parentRunId"]) == {parent["run_id"].iloc[0]}
     keys = {"rrt_star", "nrrt_star", "vnrrt_star"} | {
-        f"m_vnrrt_star@{t:g}" for t in {0.5, 0.9, 0.99, cfg.planner.tau}}  # fmt: skip
+        f"m_vnrrt_star@{t:g}" for t in {0.5, 0.9, 0.99, cfg.planner.tau}
+    }
     assert set(children["tags.planner"]) == keys
     assert children["metrics.optimal/random/success_rate"].notna().all()
 
 
-def test_the_table_does_not_depend_on_the_split(cfg, tmp_path):
+def test_the_table_does_not_depend_on_the_split(cfg, repo, tmp_path):
     """One part gives the same trials (all but the timings) as three parts merged."""
-    split = read_trials(cfg.paths.trials, cfg.eval.parts)
+    split = read_table(cfg.paths.trials_table)
     one = copy.deepcopy(cfg)
     one.eval.parts, one.paths.trials = [0], str(tmp_path / "one")
-    run_trials_part(one, 0)
-    whole = read_trials(one.paths.trials, [0])
+    run_trials_part(view(one, "trials@0", repo), 0)
+    whole = merge_parts(one.paths.trials, [0], len(split))
     pd.testing.assert_frame_equal(whole[DETERMINISTIC], split[DETERMINISTIC])
 
 
-def test_missing_or_foreign_parts_are_refused(cfg, tmp_path):
-    with pytest.raises(FileNotFoundError, match="part_5.csv"):
-        read_trials(cfg.paths.trials, [0, 5])
-    with pytest.raises(ValueError, match="a part is missing, repeated or from another config"):
-        read_trials(cfg.paths.trials, [0, 0, 1, 2])
+def test_missing_repeated_or_foreign_parts_and_heatmaps_are_refused(cfg, repo, tmp_path):
+    n = len(read_table(cfg.paths.trials_table))
+    with pytest.raises(TableError, match="part_5.csv"):
+        merge_parts(cfg.paths.trials, [0, 5], n)
+    with pytest.raises(TableError, match="a part is missing, repeated or from another config"):
+        merge_parts(cfg.paths.trials, [0, 0, 1, 2], n)
     bad = copy.deepcopy(cfg)
     bad.eval.parts = [1, 2]
     with pytest.raises(Exception, match=r"eval.parts=\[1, 2\]"):
-        run_trials_part(bad, 1)
-    assert trials_file(tmp_path, 3).name == "part_3.csv"
+        run_trials_part(view(bad, "trials@1", repo), 1)
+    swapped = copy.deepcopy(cfg)  # part 1's file copied over part 0: wrong instances
+    swapped.paths.heatmaps = str(tmp_path / "heat")
+    (tmp_path / "heat").mkdir()
+    part1 = part_file(cfg.paths.heatmaps, 1).read_bytes()
+    part_file(tmp_path / "heat", 0).write_bytes(part1)
+    part_file(tmp_path / "heat", 1).write_bytes(part1)
+    swapped.paths.trials = str(tmp_path / "trials")
+    with pytest.raises(ValueError, match="do not cover the instances"):
+        run_trials_part(view(swapped, "trials@0", repo), 0)

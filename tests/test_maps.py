@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from vnrrt.config import DataConfig
+from vnrrt.maps.config import DataConfig
 from vnrrt.maps.generate import MapGenerationError, generate_map, map_rng
 from vnrrt.maps.named import NAMES, named_map
 from vnrrt.maps.shapes import draw_shape

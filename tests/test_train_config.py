@@ -5,11 +5,11 @@ import pytest
 from hydra.utils import instantiate
 
 from tests.train_helpers import SMALL
-from vnrrt.callbacks import LogProgress, progress_callbacks
 from vnrrt.config import CONF_DIR, compose
 from vnrrt.data.datamodule import ShardDataModule
 from vnrrt.model.module import VertexNetModule
-from vnrrt.train import resolve_precision
+from vnrrt.training.callbacks import LogProgress, progress_callback
+from vnrrt.training.train import resolve_precision
 
 TRAINERS = sorted(p.stem for p in (CONF_DIR / "trainer").glob("*.yaml"))
 
@@ -58,5 +58,4 @@ def test_precision_is_bf16_on_gpu_and_32_on_cpu():
 
 
 def test_non_tty_logs_get_log_lines_instead_of_a_bar():
-    callbacks, bar = progress_callbacks(10)  # pytest captures stderr: not a TTY
-    assert bar is False and isinstance(callbacks[0], LogProgress)
+    assert isinstance(progress_callback(10), LogProgress)  # pytest captures stderr: no TTY

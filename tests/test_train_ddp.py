@@ -10,10 +10,10 @@ from pathlib import Path
 import pytest
 from mlflow import MlflowClient
 
-from tests.conftest import copy_pipeline
+from tests.conftest import copy_dvc_files, copy_pipeline
 from tests.train_helpers import QUICK, SMALL, paths
 from vnrrt.config import compose, dump
-from vnrrt.data.heatmaps import read_heatmaps, read_parts
+from vnrrt.data.heatmaps import read_parts
 from vnrrt.model.checkpoint import load_network
 
 REPO = Path(__file__).resolve().parents[1]
@@ -39,7 +39,7 @@ def test_ddp_trains_on_two_cpu_processes(small_data, tmp_path):
     assert metrics["steps"] == 2 and metrics["train_images"] == 2 * 4 * 2  # 2 processes
     load_network(tmp_path / "models" / "vertexnet.ckpt", "vertexnet")
     client = MlflowClient(f"sqlite:///{tmp_path / 'mlflow.db'}")
-    runs = client.search_runs([client.get_experiment_by_name("vnrrt").experiment_id])
+    runs = client.search_runs([client.get_experiment_by_name("vnrrt-smoke").experiment_id])
     assert len(runs) == 1  # rank 0 only
 
 
@@ -48,18 +48,15 @@ def test_dvc_repro_trains_both_networks_and_predicts(tmp_path):
     copy_pipeline(REPO, tmp_path)
     run(["git", "init", "-q"], tmp_path)
     run(["dvc", "init", "-q"], tmp_path)
+    copy_dvc_files(REPO, tmp_path)
     (tmp_path / "params.yaml").write_text(dump(compose(["scale=smoke"])))
-    run(["dvc", "repro", "predict_named"], tmp_path)
-    named = read_heatmaps(tmp_path / "data" / "heatmaps_named.npz")
-    test = read_parts(tmp_path / "data" / "heatmaps", [0, 1])
+    run(["dvc", "repro", "predict_metrics"], tmp_path)
+    heat = read_parts(tmp_path / "data/smoke/heatmaps", [0, 1])
     for name, kind in (("vertexnet", "vertex"), ("nrrtnet", "path")):
-        _, record = load_network(tmp_path / "models" / f"{name}.ckpt", name)
+        _, record = load_network(tmp_path / "models/smoke" / f"{name}.ckpt", name)
         assert record["target"]["kind"] == kind
-        assert named["maps"][name].shape == (5, 200, 200)
-        assert test["maps"][name].shape == (8, 200, 200)
-    shown = run(["dvc", "metrics", "show", "--json"], tmp_path)
-    assert "train_vertexnet.json" in shown and "predict.json" in shown
+        assert heat["maps"][name].shape == (5 + 8, 200, 200)
     client = MlflowClient(f"sqlite:///{tmp_path / 'mlflow.db'}")  # <repo>/mlflow.db
-    runs = client.search_runs([client.get_experiment_by_name("vnrrt").experiment_id])
-    assert sorted(r.data.tags["dvc_stage"] for r in runs) == ["train_nrrtnet", "train_vertexnet"]
-    assert "didn't change" in run(["dvc", "repro", "predict_named"], tmp_path)
+    runs = client.search_runs([client.get_experiment_by_name("vnrrt-smoke").experiment_id])
+    assert sorted(r.data.tags["dvc_stage"] for r in runs) == ["train@nrrtnet", "train@vertexnet"]
+    assert "didn't change" in run(["dvc", "repro", "predict_metrics"], tmp_path)

@@ -9,11 +9,11 @@ import torch
 from hydra.utils import instantiate
 
 from tests.train_helpers import QUICK, paths, small_cfg
-from vnrrt.callbacks import LogProgress
 from vnrrt.config import compose
 from vnrrt.model.checkpoint import CheckpointError, load_network, read_checkpoint
 from vnrrt.model.metrics import VertexRecall
-from vnrrt.train import train
+from vnrrt.training.callbacks import LogProgress
+from vnrrt.training.stage import run_train as train
 
 
 def test_fast_dev_run_of_the_real_smoke_config(smoke_data, tmp_path):

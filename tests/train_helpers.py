@@ -6,10 +6,13 @@ from pathlib import Path
 
 from omegaconf import DictConfig
 
-from vnrrt.config import DataConfig, LabelsConfig, compose, section
-from vnrrt.data.build import build_named_maps, build_shard
+from vnrrt.config import compose, section
+from vnrrt.data.build import build_shard
+from vnrrt.data.build_named import build_named_maps
+from vnrrt.data.config import LabelsConfig
 from vnrrt.data.manifest import build_manifest
 from vnrrt.data.shards import shard_file
+from vnrrt.maps.config import DataConfig
 
 # The smoke scale on 64x64 maps: the same pipeline, about 10x cheaper per image than 200x200.
 SMALL = [
@@ -46,7 +49,8 @@ def paths(data: Path, out: Path) -> list[str]:
         f"paths.metrics={out / 'metrics'}",
         f"paths.figures={out / 'figures'}",
         f"paths.heatmaps={out / 'heatmaps'}",
-        f"paths.named_heatmaps={out / 'heatmaps_named.npz'}",
+        f"paths.timing={out / 'timing'}",
+        f"paths.instances={out / 'instances.npz'}",
         f"logger.uri=sqlite:///{out / 'mlflow.db'}",
         f"logger.artifact_location={out / 'mlartifacts'}",
     ]

@@ -156,9 +156,9 @@ def run_plan(args: argparse.Namespace) -> int:
         print(f"reference lengths: none ({err})")
     print(f"path: {len(result.path)} points; fallback_uniform={result.fallback_uniform}")
     if args.out:
-        from vnrrt import viz
+        from vnrrt.viz.planners import save_plan
 
-        viz.save_plan(args.out, inst["grid"], result, start, goal, heatmap)
+        save_plan(args.out, inst["grid"], result, start, goal, heatmap)
         print(f"figure: {args.out}")
     return 0 if result.success else 1
 

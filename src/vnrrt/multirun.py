@@ -1,7 +1,7 @@
 """Shard jobs as a Hydra app: one job runs one part of a stage with parts, writing the very
 file ``dvc repro`` writes.
 
-The stages with parts (:data:`vnrrt.pipeline.PART_STAGES`) are ``shard`` (``shard@<id>``,
+The stages with parts (:data:`PART_STAGES`) are ``shard`` (``shard@<id>``,
 ids ``scale.shards``: map generation and labelling), ``predict`` (``predict@<k>``, ids
 ``predict.parts``: heatmap prediction) and ``trials`` (``trials@<k>``, ids ``eval.parts``:
 planner trials). The app composes the pipeline's own config (``conf/config.yaml``) plus
@@ -9,7 +9,7 @@ planner trials). The app composes the pipeline's own config (``conf/config.yaml`
 Hydra's launchers spread a sweep over ids (``docs/scaling.md``); run from the repository
 root::
 
-    python -m vnrrt.config scale=paper > params.yaml   # the same overrides as the jobs
+    python -m vnrrt.params scale=paper --out params.yaml   # the same overrides as the jobs
     python -m vnrrt.multirun -m hydra/launcher=local +stage=shard +part=0,1,2,3 workers=1
     python -m vnrrt.multirun -m hydra/launcher=slurm +stage=shard +part='range(0,100)' scale=paper
     dvc commit -f shard                                 # `dvc repro` then skips shard@*
@@ -30,8 +30,14 @@ import hydra
 from hydra.utils import to_absolute_path
 from omegaconf import DictConfig, OmegaConf
 
-from vnrrt.config import CONF_DIR, ConfigError, load_params
-from vnrrt.pipeline import PART_STAGES
+from vnrrt.config import CONF_DIR, ConfigError, load_params, restrict, stage_params
+
+# Stages with parts: name -> (module, entry point taking (cfg, part id), key of the part ids).
+PART_STAGES = {
+    "shard": ("vnrrt.data.stage", "run_shard", "scale.shards"),
+    "predict": ("vnrrt.predict.stage", "run_predict_part", "predict.parts"),
+    "trials": ("vnrrt.evaluation.stage", "run_trials_part", "eval.parts"),
+}
 
 log = logging.getLogger(__name__)
 
@@ -69,7 +75,12 @@ def part_job(cfg: DictConfig) -> object:
         raise ConfigError(f"pass +{STAGE_KEY}=<{'|'.join(PART_STAGES)}> and +{PART_KEY}=<id> "
                           f"(got {STAGE_KEY}={stage!r}, {PART_KEY}={part!r}); sweep with "
                           f"-m +{PART_KEY}=0,1")  # fmt: skip
-    run, ids_key = PART_STAGES[stage]
+    import importlib
+
+    from vnrrt.validate import validate_config
+
+    module, entry, ids_key = PART_STAGES[stage]
+    validate_config(cfg)
     ids = OmegaConf.select(cfg, ids_key)
     if int(part) not in list(ids):
         raise ConfigError(f"{PART_KEY}={part} is not in {ids_key}={list(ids)}")
@@ -77,10 +88,12 @@ def part_job(cfg: DictConfig) -> object:
     if differ:
         log.warning(
             "config differs from params.yaml in %s: write params.yaml with the same overrides "
-            "(python -m vnrrt.config ... > params.yaml) before `dvc commit`",
+            "(python -m vnrrt.params ... --out params.yaml) before `dvc commit`",
             differ,
         )
-    return run(with_absolute_paths(cfg), int(part))
+    run = getattr(importlib.import_module(module), entry)
+    view = restrict(with_absolute_paths(cfg), stage_params(stage, to_absolute_path("dvc.yaml")))
+    return run(view, int(part))
 
 
 @hydra.main(config_path=str(CONF_DIR), config_name="config", version_base="1.3")

@@ -13,12 +13,13 @@ from pathlib import Path
 
 import numpy as np
 
-from vnrrt.config import DataConfig, LabelsConfig, asdict
+from vnrrt.config import asdict
+from vnrrt.data.config import LabelsConfig
 from vnrrt.data.label import MapLabels, label_map
 from vnrrt.data.reader import TEST, TRAIN
 from vnrrt.data.shards import FORMAT_VERSION, meta_json, write_shard
+from vnrrt.maps.config import DataConfig
 from vnrrt.maps.generate import FloorMap, generate_map, map_rng
-from vnrrt.maps.named import NAMES, named_map
 from vnrrt.parallel import parallel_map
 
 log = logging.getLogger(__name__)
@@ -106,12 +107,3 @@ def build_shard(
         out, results, map_ids, split, seed=seed, shard=shard_id, maps_per_shard=maps_per_shard,
         map_size=data.size, data=asdict(data), labels=asdict(labels),
     )  # fmt: skip
-
-
-def build_named_maps(out: str | Path, size: int, labels: LabelsConfig) -> dict:
-    """Write the five named maps (:mod:`vnrrt.maps.named`) as a shard of 5 test instances."""
-    maps = [named_map(name, size) for name in NAMES]
-    results = [(fm, label_map(fm, labels.vertex_steps)) for fm in maps]
-    split = np.full(len(maps), TEST, np.uint8)
-    meta = {"names": list(NAMES), "map_size": size, "labels": asdict(labels)}
-    return write_labelled(out, results, np.arange(len(maps)), split, **meta)

@@ -20,15 +20,14 @@ import numpy as np
 import torch
 from torch.utils.data import DataLoader, Dataset, Sampler
 
-from vnrrt.data.manifest import verify_manifest
-from vnrrt.data.reader import TRAIN, Shard
-from vnrrt.data.shards import ShardError, shard_file
+from vnrrt.data.manifest import verified_files
+from vnrrt.data.reader import Shard
+from vnrrt.data.splits import SPLIT_NAMES, evenly_spaced, split_keys
 from vnrrt.data.targets import check_target, target_mask
 from vnrrt.maps.render import NORMALIZATIONS, class_map, colorize, to_input
 from vnrrt.search import path_mask
 
 log = logging.getLogger(__name__)
-SPLIT_NAMES = ("train", "val", "test")
 
 
 class InstanceDataset(Dataset):
@@ -102,55 +101,6 @@ class EpochShuffle(Sampler[int]):
         return self.n
 
 
-def evenly_spaced(keys: np.ndarray, n: int | None) -> np.ndarray:
-    """At most ``n`` rows of ``keys`` ``(N, 2)`` at evenly spaced positions (all if ``n`` is
-    None or >= N), in their original order."""
-    if n is None or n >= len(keys):
-        return keys
-    if n < 0:
-        raise ValueError(f"an instance limit must be >= 0, got {n}")
-    return keys[np.unique(np.linspace(0, len(keys) - 1, n).round().astype(np.int64))]
-
-
-def split_keys(shards: list[Shard], seed: int, shard_ids: list[int], val_fraction: float):
-    """``{"train", "val", "test"}`` -> keys ``(N, 2)`` int64 (file position, instance index).
-
-    ``test``: the shards' test maps. ``val``: ``round(val_fraction * n_train_maps)`` of each
-    shard's train maps (at least one, and one left for training, when ``val_fraction > 0``),
-    drawn with a generator seeded by ``(seed, shard id)``; ``train``: the other train maps.
-    """
-    if not 0.0 <= val_fraction < 1.0:
-        raise ValueError(f"val_fraction must be in [0, 1), got {val_fraction}")
-    out: dict[str, list[np.ndarray]] = {name: [] for name in SPLIT_NAMES}
-    for pos, (shard, sid) in enumerate(zip(shards, shard_ids, strict=True)):
-        train_maps = np.flatnonzero(shard.arrays["split"] == TRAIN)
-        rng = np.random.default_rng(np.random.SeedSequence([seed, sid, 0x76616C]))
-        n_val = int(round(val_fraction * len(train_maps)))
-        if val_fraction > 0 and len(train_maps) > 1:
-            n_val = min(max(n_val, 1), len(train_maps) - 1)  # at least one map in each
-        val_maps = rng.choice(train_maps, n_val, replace=False)
-        inst_map = shard.arrays["inst_map"]
-        split_of = np.where(np.isin(inst_map, val_maps), 1, 0)  # 0 train, 1 val
-        split_of[shard.arrays["split"][inst_map] != TRAIN] = 2  # test
-        for k, name in enumerate(SPLIT_NAMES):
-            idx = np.flatnonzero(split_of == k)
-            out[name].append(np.stack([np.full(len(idx), pos), idx], axis=1))
-    return {k: np.concatenate(v).astype(np.int64) for k, v in out.items()}
-
-
-def verified_files(shards_dir, manifest, shard_ids: list[int]) -> list[Path]:
-    """Shard files of ``shard_ids``, each checked against its checksum in ``manifest``.
-
-    Raises :class:`ShardError` naming a shard that is modified, missing or not in the manifest.
-    """
-    listed = {p.resolve() for p in verify_manifest(manifest)}
-    files = [shard_file(shards_dir, s) for s in shard_ids]
-    for f in files:
-        if f.resolve() not in listed:
-            raise ShardError(f"shard {f} is not listed in manifest {manifest} (run `dvc repro`)")
-    return files
-
-
 class ShardDataModule(L.LightningDataModule):
     """Train/val/test loaders over verified shards (module doc: splits, limits, seeding).
 
@@ -212,10 +162,3 @@ class ShardDataModule(L.LightningDataModule):
 
     def test_dataloader(self) -> DataLoader:
         return self._loader("test")
-
-
-def evaluation_keys(shards: list[Shard], n: int | None) -> np.ndarray:
-    """The evaluation instances: ``n`` evenly spaced keys ``(R, 2)`` int64 (file position,
-    instance index) of the test split (the shards' test maps, in shard order)."""
-    test = split_keys(shards, 0, list(range(len(shards))), 0.0)["test"]
-    return evenly_spaced(test, n)

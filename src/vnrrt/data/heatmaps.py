@@ -30,7 +30,7 @@ from pathlib import Path
 
 import numpy as np
 
-from vnrrt.data.shards import atomic_write_bytes
+from vnrrt.io import atomic_write_bytes
 
 FORMAT_VERSION = 2
 PREFIX = "net_"  # field name prefix of a network's heatmaps

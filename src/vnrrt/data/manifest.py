@@ -7,7 +7,6 @@ pipeline wrote (:func:`verify_manifest`); ``data.json`` holds the figures DVC re
 
 from __future__ import annotations
 
-import hashlib
 import json
 import os
 from pathlib import Path
@@ -15,16 +14,8 @@ from pathlib import Path
 import numpy as np
 
 from vnrrt.data.reader import TEST, TRAIN, Shard
-from vnrrt.data.shards import FORMAT_VERSION, ShardError, atomic_write_bytes, shard_file
-
-
-def sha256(path: Path) -> str:
-    """Hex sha256 of a file's bytes."""
-    h = hashlib.sha256()
-    with open(path, "rb") as f:
-        for block in iter(lambda: f.read(1 << 20), b""):
-            h.update(block)
-    return h.hexdigest()
+from vnrrt.data.shards import FORMAT_VERSION, ShardError, shard_file
+from vnrrt.io import sha256, write_json
 
 
 def shard_entry(path: Path) -> dict:
@@ -66,12 +57,6 @@ def summarize(entries: list[dict]) -> dict:
     }
 
 
-def write_json(path: str | Path, obj: dict) -> None:
-    """Write ``obj`` as indented JSON, atomically."""
-    text = json.dumps(obj, indent=2, sort_keys=True) + "\n"
-    atomic_write_bytes(Path(path), lambda f: f.write(text.encode()))
-
-
 def build_manifest(shards_dir: str | Path, shard_ids: list[int], out: str | Path) -> dict:
     """Write ``out`` (manifest JSON) for shards ``shard_ids``; return the summary metrics."""
     entries = [shard_entry(shard_file(shards_dir, i)) for i in shard_ids]
@@ -100,3 +85,16 @@ def verify_manifest(manifest: str | Path) -> list[Path]:
             raise ShardError(f"shard {path} does not match its checksum in {manifest}")
         paths.append(path)
     return paths
+
+
+def verified_files(shards_dir, manifest, shard_ids: list[int]) -> list[Path]:
+    """Shard files of ``shard_ids``, each checked against its checksum in ``manifest``.
+
+    Raises :class:`ShardError` naming a shard that is modified, missing or not in the manifest.
+    """
+    listed = {p.resolve() for p in verify_manifest(manifest)}
+    files = [shard_file(shards_dir, s) for s in shard_ids]
+    for f in files:
+        if f.resolve() not in listed:
+            raise ShardError(f"shard {f} is not listed in manifest {manifest} (run `dvc repro`)")
+    return files

@@ -30,11 +30,12 @@ arrays; writes go to a temporary file that is renamed into place (atomic).
 from __future__ import annotations
 
 import json
-import os
 import zipfile
 from pathlib import Path
 
 import numpy as np
+
+from vnrrt.io import atomic_write_bytes
 
 FORMAT_VERSION = 1
 FIELDS = {
@@ -63,20 +64,6 @@ class ShardError(ValueError):
 def shard_file(shards_dir: str | Path, shard_id: int) -> Path:
     """Path of shard ``shard_id`` in ``shards_dir`` (the name dvc.yaml declares)."""
     return Path(shards_dir) / f"shard_{shard_id}.npz"
-
-
-def atomic_write_bytes(path: Path, write) -> None:
-    """Call ``write(file)`` on a temp file beside ``path``, fsync, then rename into place."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f"{path.name}.tmp-{os.getpid()}")
-    try:
-        with open(tmp, "wb") as f:
-            write(f)
-            f.flush()
-            os.fsync(f.fileno())
-        os.replace(tmp, path)
-    finally:
-        tmp.unlink(missing_ok=True)
 
 
 def write_shard(path: str | Path, arrays: dict[str, np.ndarray]) -> None:

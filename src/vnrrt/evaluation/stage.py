@@ -1,147 +1,131 @@
-"""Entry points of the ``trials@<part>``, ``evaluate`` and ``report`` DVC stages, and their
-MLflow runs.
+"""Entry points of the evaluation stages: parameters in, typed arguments out, one call each.
 
-``trials@<k>`` runs part ``k`` of the protocol's trials into ``<paths.trials>/part_<k>.csv``;
-``evaluate`` merges the parts and writes the summary metrics and convergence curves;
-``report`` turns the table into ``paper_comparison.md`` and the figures, and logs one
-MLflow run per planner configuration nested under a parent ``evaluation`` run, with the
-report and figures as the parent's artifacts.
+* ``instances``: the protocol's instances with their reference lengths
+  (:func:`vnrrt.evaluation.instances.build_instances`);
+* ``trials@<k>``: part ``k`` of the protocol's trials (:mod:`vnrrt.evaluation.trials`);
+* ``evaluate``: the parts merged once into the trial table, and its statistics
+  (:func:`vnrrt.evaluation.analysis.analyze`);
+* ``report``: ``paper_comparison.md``, the figures, the headline metrics and the MLflow runs
+  (:mod:`vnrrt.evaluation.stage_report`).
+
+Each function receives the parameters its ``dvc.yaml`` entry declares
+(:func:`vnrrt.config.restrict`); heavy imports stay inside the functions, so a stage's code
+dependencies are what it runs.
 """
 
 from __future__ import annotations
 
-import json
 import logging
-from pathlib import Path
 
-import pandas as pd
 from omegaconf import DictConfig
 
-from vnrrt import tracking
-from vnrrt.config import ConfigError, ScaleConfig, check_parts, section
-from vnrrt.data.manifest import write_json
-from vnrrt.evaluation.evaluate import (
-    EvalConfig,
-    convergence_curves,
-    evaluate_part,
-    protocol_jobs,
-    read_trials,
-    summary_metrics,
-    trials_file,
-    write_table,
-)
-from vnrrt.evaluation.report import build_report, check_trials, load_paper_tables
-from vnrrt.evaluation.stats import improvement_ci
-from vnrrt.planners import PlannerConfig
+from vnrrt.config import section
+from vnrrt.evaluation.config import EvalConfig, StatsConfig
 
 log = logging.getLogger(__name__)
 
 
-def _protocol(cfg: DictConfig) -> tuple[EvalConfig, PlannerConfig, dict, dict]:
-    """The ``eval`` and ``planner`` sections, network -> heatmap source, and the
-    :func:`~vnrrt.evaluation.instances.load_eval_instances` arguments of ``cfg``."""
+def _protocol(cfg: DictConfig):
+    """``(eval config, configurations, trial counts)`` of ``cfg`` (M-VNRRT* at every
+    ``planner.taus`` value and ``planner.tau``)."""
+    from vnrrt.evaluation.protocol import planner_specs, trial_counts
+
     ev = section(cfg, "eval", EvalConfig)
-    planner = section(cfg, "planner", PlannerConfig)
-    scale = section(cfg, "scale", ScaleConfig)
-    targets = {name: cfg.networks[name].target for name in cfg.networks}
-    sources = {targets[n]: n for n in sorted(set(ev.networks.values()))}
-    args = dict(named_maps=cfg.paths.named_maps, shards_dir=cfg.paths.shards,
-                shard_ids=scale.shards, named_heatmaps=cfg.paths.named_heatmaps,
-                heatmaps_dir=cfg.paths.heatmaps,
-                parts=check_parts(cfg.predict.parts, "predict.parts"), sources=sources,
-                n_random=ev.random_maps)  # fmt: skip
-    return ev, planner, targets, args
+    taus = [*cfg.planner.taus, cfg.planner.tau]
+    return ev, planner_specs(ev, taus), trial_counts(ev)
+
+
+def run_instances(cfg: DictConfig) -> dict:
+    """Stage ``instances``: named maps and ``eval.random_maps`` test instances with their
+    A* and exact optima -> ``paths.instances``."""
+    from vnrrt.data.manifest import verified_files
+    from vnrrt.evaluation.build_instances import build_instances
+
+    shards = [int(s) for s in cfg.scale.shards]
+    files = verified_files(cfg.paths.shards, cfg.paths.manifest, shards)
+    return build_instances(
+        cfg.paths.instances,
+        cfg.paths.named_maps,
+        files,
+        shards,
+        int(cfg.eval.random_maps),
+        int(cfg.workers),
+    )
 
 
 def run_trials_part(cfg: DictConfig, part: int) -> int:
     """Stage ``trials@<part>``: the trials of part ``part`` of ``eval.parts`` ->
     ``<paths.trials>/part_<part>.csv``; returns the number of trials."""
-    ev, planner, targets, args = _protocol(cfg)
+    from vnrrt.config import ConfigError, check_parts
+    from vnrrt.evaluation.instances import Instances, load
+    from vnrrt.evaluation.protocol import part_jobs, trial_jobs
+    from vnrrt.evaluation.table import part_file, write_table
+    from vnrrt.evaluation.trials import run_jobs
+    from vnrrt.planners.config import PlannerConfig
+
+    ev, specs, counts = _protocol(cfg)
+    planner = section(cfg, "planner", PlannerConfig)
     if part not in ev.parts:
         raise ConfigError(f"part {part} is not in eval.parts {ev.parts}")
-    table = evaluate_part(
-        args, ev, planner, targets, int(cfg.seed), int(cfg.get("workers", 0)), part
+    jobs = trial_jobs(Instances(cfg.paths.instances).kinds, specs, counts)
+    jobs = part_jobs(jobs, part, len(ev.parts))
+    networks = sorted({s.source for s in specs if s.source is not None})
+    indices = sorted({job.instance for job in jobs})
+    parts = check_parts(cfg.predict.parts, "predict.parts")
+    instances = load(cfg.paths.instances, indices, networks, cfg.paths.heatmaps, parts)
+    log.info(
+        "part %d/%d: %d trial jobs on %d instances", part, len(ev.parts), len(jobs), len(instances)
     )
-    write_table(table, trials_file(cfg.paths.trials, part))
+    table = run_jobs(jobs, instances, int(cfg.seed), int(cfg.workers), planner)
+    write_table(table, part_file(cfg.paths.trials, part))
     return len(table)
 
 
 def run_evaluate(cfg: DictConfig) -> dict:
-    """Stage ``evaluate``: the parts' trials merged -> summary metrics (``eval.json``) and
-    convergence curves; checks that the parts hold every trial of this config's protocol."""
-    ev, planner, targets, args = _protocol(cfg)
-    expected = sum(job.count for job in protocol_jobs(args, ev, planner, targets))
-    trials = read_trials(cfg.paths.trials, ev.parts, expected)
-    metrics = summary_metrics(trials)
-    write_json(f"{cfg.paths.metrics}/eval.json", metrics)
-    write_table(convergence_curves(trials, planner.eps), f"{cfg.paths.plots}/convergence.csv")
-    return metrics
+    """Stage ``evaluate``: the trial parts merged (checked complete) -> the trial table,
+    its statistics (``paths.summary``) and the convergence curves."""
+    from vnrrt.evaluation.analysis import analyze, convergence_curves, load_paper_tables
+    from vnrrt.evaluation.instances import Instances
+    from vnrrt.evaluation.protocol import trial_jobs
+    from vnrrt.evaluation.table import merge_parts, write_table
+    from vnrrt.io import write_json, write_text
 
-
-def improvements_over(trials: pd.DataFrame, baseline: str, stop: str) -> dict:
-    """``{planner key: {map_set: (improvement, ci_low, ci_high)}}`` of time over ``baseline``."""
-    t = check_trials(trials)
-    t = t[(t["stop"] == stop) & t["success"]]
-    out: dict = {}
-    for (key, map_set), sub in t.groupby(["key", "map_set"]):
-        base = t[(t["key"] == baseline) & (t["map_set"] == map_set)]["time_to_stop"]
-        if key != baseline and len(base) and len(sub):
-            out.setdefault(key, {})[map_set] = improvement_ci(base, sub["time_to_stop"])
-    return out
-
-
-def run_report(cfg: DictConfig) -> Path:
-    """Stage ``report``: ``paper_comparison.md``, Fig. 5 and convergence figures, MLflow."""
-    from vnrrt import viz
-
-    trials = read_trials(cfg.paths.trials, section(cfg, "eval", EvalConfig).parts)
+    ev, specs, counts = _protocol(cfg)
+    eps = float(cfg.planner.eps)
+    expected = sum(j.count for j in trial_jobs(Instances(cfg.paths.instances).kinds, specs, counts))
+    table = merge_parts(cfg.paths.trials, ev.parts, expected)
+    write_table(table, cfg.paths.trials_table)
     paper = load_paper_tables(cfg.paths.paper_tables)
-    out = Path(cfg.paths.report)
-    text = build_report(trials, paper)
-    from vnrrt.data.shards import atomic_write_bytes
+    st = section(cfg, "stats", StatsConfig)
+    summary = analyze(table, paper, eps, st.bootstrap, st.level)
+    write_json(cfg.paths.summary, summary)
+    curves = convergence_curves(table, eps)
+    write_text(f"{cfg.paths.plots}/convergence.csv", curves.to_csv(index=False))
+    for map_set, frame in series_per_map_set(curves).items():
+        write_text(f"{cfg.paths.plots}/convergence/{map_set}.csv", frame.to_csv(index=False))
+    return summary
 
-    atomic_write_bytes(out, lambda f: f.write(text.encode()))
-    figs = Path(cfg.paths.figures)
-    titles = {"initial": "initial solutions", "optimal": "optimal solutions (1% of A*)",
-              "optimal_any_angle": "optimal solutions (1% of any-angle)"}  # fmt: skip
-    for stop in ("initial", "optimal", "optimal_any_angle"):
-        viz.save_improvements(figs / f"improvement_{stop}.png",
-                              improvements_over(trials, "rrt_star", stop),
-                              f"Time improvement over RRT*, {titles[stop]}")  # fmt: skip
-    curves = pd.read_csv(f"{cfg.paths.plots}/convergence.csv")
-    viz.save_convergence_table(figs / "convergence.png", curves)
-    if cfg.logger.enabled:
-        log_evaluation(cfg, trials, [out, *sorted(figs.glob("*.png"))])
+
+def series_per_map_set(curves) -> dict:
+    """``dvc plots`` data: per map set, the stop rule ``optimal`` curves as columns planner
+    (display name), median_time_ms and cost_ratio (template ``.dvc/plots/series.json``)."""
+    from vnrrt.names import display_name
+
+    opt = curves[curves["stop"] == "optimal"]
+    out = {}
+    for map_set, sub in opt.groupby("map_set", sort=False):
+        frame = sub.assign(
+            planner=[display_name(k) for k in sub["planner"]],
+            median_time_ms=1e3 * sub["median_time"],
+            cost_ratio=sub["factor"],
+        )
+        out[map_set] = frame[["planner", "median_time_ms", "cost_ratio"]]
     return out
 
 
-def _metric_name(*parts: str) -> str:
-    return "/".join(p.replace("@", "_tau") for p in parts)
+def run_report(cfg: DictConfig):
+    """Stage ``report``: report, figures, headline metrics and MLflow runs
+    (:func:`vnrrt.evaluation.stage_report.report`)."""
+    from vnrrt.evaluation.stage_report import report
 
-
-def log_evaluation(cfg: DictConfig, trials: pd.DataFrame, artifacts: list[Path]) -> str:
-    """A parent MLflow run with one nested run per planner configuration; returns its id."""
-    import mlflow
-
-    mlflow.set_tracking_uri(tracking.tracking_uri(cfg.logger.uri))
-    name = cfg.logger.experiment
-    if mlflow.get_experiment_by_name(name) is None:
-        mlflow.create_experiment(name, tracking.artifact_location(cfg.logger.artifact_location))
-    mlflow.set_experiment(name)
-    tags = {**tracking.run_tags("evaluation", cfg.scale.name), "kind": "evaluation"}
-    metrics = summary_metrics(trials)
-    with mlflow.start_run(run_name=f"evaluation-{cfg.scale.name}", tags=tags) as parent:
-        mlflow.log_params(tracking.flat_params({k: cfg[k] for k in ("planner", "eval", "seed")}))
-        for key, sub in check_trials(trials).groupby("key"):
-            with mlflow.start_run(run_name=key, nested=True, tags={**tags, "planner": key}):
-                mlflow.log_params({"planner": sub["planner"].iloc[0], "tau": sub["tau"].iloc[0],
-                                   "trials": len(sub)})  # fmt: skip
-                for stop, per_key in metrics.items():
-                    for map_set, vals in per_key.get(key, {}).items():
-                        mlflow.log_metrics({_metric_name(stop, map_set, m): v
-                                            for m, v in vals.items() if pd.notna(v)})  # fmt: skip
-                mlflow.log_text(sub.to_csv(index=False), "trials.csv")
-        mlflow.log_text(json.dumps(metrics, indent=1), "eval_metrics.json")
-        for path in artifacts:
-            mlflow.log_artifact(str(path))
-        return parent.info.run_id
+    return report(cfg)

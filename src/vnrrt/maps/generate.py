@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from vnrrt.config import DataConfig
+from vnrrt.maps.config import DataConfig
 from vnrrt.maps.shapes import draw_shape
 
 

@@ -21,7 +21,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from vnrrt.config import DataConfig
+from vnrrt.maps.config import DataConfig
 from vnrrt.maps.generate import FloorMap, draw_obstacles, largest_free_region
 
 NAMES = ("open", "cluttered", "narrow_passage", "u_trap", "maze")

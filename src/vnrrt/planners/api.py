@@ -2,9 +2,11 @@
 
 Coordinates follow :mod:`vnrrt.grid`: ``grid`` is ``(H, W)`` indexed ``grid[y, x]``
 (nonzero = obstacle), start and goal are continuous ``(x, y)`` pixel points (cell
-centres ``(x + 0.5, y + 0.5)`` for dataset instances). Timings cover sampler
-construction and the tree search, not JIT compilation (done once per process by
-:func:`warmup`) nor the reference-length computation (an oracle, not part of planning).
+centres ``(x + 0.5, y + 0.5)`` for dataset instances). Timings cover the tree
+search only: building the sampler from a heatmap (per map, once; reported as
+``setup_time``), JIT compilation (once per process, :func:`warmup`) and the reference-length
+computation (an oracle, not part of planning) are outside the timed region. A sampler can be
+built once with :func:`make_sampler` and passed to many :func:`plan` calls.
 """
 
 from __future__ import annotations
@@ -51,6 +53,31 @@ def make_sampler(
     return heatmap_sampler(heatmap, shape, mix)
 
 
+SAMPLER_KINDS = {
+    "rrt_star": "uniform",
+    "nrrt_star": "heatmap",
+    "vnrrt_star": "heatmap",
+    "m_vnrrt_star": "masked",
+}
+
+
+def check_sampler(
+    sampler: Sampler, planner: str, shape: tuple[int, int], heatmap=None, tau=None
+) -> None:
+    """Raise ``ValueError`` unless ``sampler`` is what ``planner`` samples from on a map of
+    ``shape`` (a prebuilt sampler replaces ``heatmap`` and ``tau``)."""
+    if planner not in PLANNERS:
+        raise ValueError(f"unknown planner {planner!r}; choose from {PLANNERS}")
+    if heatmap is not None or tau is not None:
+        raise ValueError("give either a prebuilt sampler or heatmap/tau, not both")
+    if sampler.kind != SAMPLER_KINDS[planner]:
+        raise ValueError(
+            f"{planner} samples from a {SAMPLER_KINDS[planner]} sampler, got a {sampler.kind} one"
+        )
+    if tuple(sampler.shape) != tuple(shape):
+        raise GridError(f"sampler is for shape {sampler.shape}, the grid has shape {shape}")
+
+
 def _check_endpoint(occ: np.ndarray, point, name: str) -> tuple[float, float]:
     x, y = as_point(occ, point, name)
     if not point_free(occ, (x, y)):
@@ -86,6 +113,7 @@ def plan(
     config: PlannerConfig | None = None,
     milestones: tuple[float, ...] = (),
     keep_tree: bool = False,
+    sampler: Sampler | None = None,
     **overrides,
 ) -> PlanResult:
     """Plan from ``start`` to ``goal`` with one of the paper's RRT* variants.
@@ -106,6 +134,8 @@ def plan(
             e.g. ``eta=5.0, max_seconds=2``.
         milestones: extra cost bounds (pixels) whose first-reach time is recorded.
         keep_tree: also return the tree (points and parents) for drawing.
+        sampler: a sampler already built by :func:`make_sampler` for this planner and map
+            (then ``heatmap`` and ``tau`` are not given); saves rebuilding it per run.
 
     Returns:
         A :class:`PlanResult`; hitting an iteration or time budget gives ``success=False``.
@@ -121,9 +151,14 @@ def plan(
     goal = _check_endpoint(occ, goal, "goal")
     if stop not in ("initial", "optimal"):
         raise ValueError(f"unknown stop rule {stop!r}; use 'initial' or 'optimal'")
-    if planner == "m_vnrrt_star" and tau is None:
+    if planner == "m_vnrrt_star" and tau is None and sampler is None:
         tau = cfg.tau
-    make_sampler(planner, occ.shape, heatmap, tau, cfg.mix)  # validate before any search
+    t0 = time.perf_counter()
+    if sampler is None:
+        sampler = make_sampler(planner, occ.shape, heatmap, tau, cfg.mix)
+    else:
+        check_sampler(sampler, planner, occ.shape, heatmap, tau)
+    setup = time.perf_counter() - t0
     if reference_length is None and stop == "optimal":
         reference_length = compute_reference(occ, start, goal, cfg.reference)
     if reference_length is not None and not (
@@ -132,19 +167,16 @@ def plan(
         raise ValueError(f"reference_length must be finite and >= 0, got {reference_length}")
     target = None if stop == "initial" else (1.0 + cfg.eps) * reference_length
     warmup()
-    result = _timed(
-        occ, start, goal, planner, heatmap, tau, target, milestones, seed, cfg, keep_tree
-    )
-    result = dataclasses.replace(result, reference_length=reference_length)
+    result = _timed(occ, start, goal, planner, sampler, target, milestones, seed, cfg, keep_tree)
+    result = dataclasses.replace(result, reference_length=reference_length, setup_time=setup)
     log.debug("%s", result.summary())
     return result
 
 
-def _timed(occ, start, goal, planner, heatmap, tau, target, milestones, seed, cfg, keep_tree):
+def _timed(occ, start, goal, planner, sampler, target, milestones, seed, cfg, keep_tree):
     """The timed part of :func:`plan` on validated inputs; ``target`` None = first solution."""
     bounds = tuple(float(m) for m in milestones)
     t0 = time.perf_counter()
-    sampler = make_sampler(planner, occ.shape, heatmap, tau, cfg.mix)
     tree = core.Tree(cfg.max_iterations + 2, occ.shape, max(cfg.eta / 2, 1.0), cfg.trace_capacity)
     wanted = {math.inf, *bounds, *([] if target is None else [target])}
     stops = np.array(sorted(wanted, reverse=True))
@@ -234,5 +266,6 @@ def warmup() -> None:
     cfg = PlannerConfig(max_iterations=200)
     heat = np.ones((8, 8))
     for planner, hm in (("rrt_star", None), ("vnrrt_star", heat)):
-        _timed(occ, (1.5, 3.5), (6.5, 3.5), planner, hm, None, 0.0, (), 0, cfg, False)
+        sampler = make_sampler(planner, occ.shape, hm)
+        _timed(occ, (1.5, 3.5), (6.5, 3.5), planner, sampler, 0.0, (), 0, cfg, False)
     log.debug("planner kernels compiled")

@@ -12,7 +12,7 @@ import math
 from dataclasses import dataclass, field
 
 PLANNERS = ("rrt_star", "nrrt_star", "vnrrt_star", "m_vnrrt_star")
-REFERENCES = ("astar", "any_angle")
+REFERENCES = ("astar", "any_angle", "taut")
 RADIUS_MODES = ("shrinking", "fixed")
 
 
@@ -37,8 +37,9 @@ class PlannerConfig:
         tau: default mask threshold of M-VNRRT* when ``plan`` gets none.
         taus: thresholds evaluated for M-VNRRT* (paper: 0.5, 0.9, 0.99).
         eps: stop rule ``optimal``: best cost <= (1 + eps) x reference length.
-        reference: ``'astar'`` (paper: 8-connected A* length) or ``'any_angle'`` (A* path
-            pulled taut by line-of-sight shortcuts).
+        reference: ``'astar'`` (paper: 8-connected A* length), ``'any_angle'`` (the exact
+            continuous optimum among closed obstacle cells, :func:`vnrrt.search.any_angle_length`)
+            or ``'taut'`` (the A* path pulled taut: an approximation, 0-6% above the exact).
         min_spacing: a sample within this distance (pixels) of its nearest node adds no
             node (the iteration counts). Without it, a concentrated heatmap (M-VNRRT*)
             draws many samples inside the same few pixels, RRT* piles nodes up there and

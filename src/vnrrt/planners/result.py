@@ -48,6 +48,8 @@ class PlanResult:
         milestones: the extra cost bounds asked for, with the time each was reached.
         fallback_uniform: a heatmap/masked sampler had no positive weight and sampled
             uniformly instead.
+        setup_time: seconds spent building the sampler (0 when a prebuilt one was given);
+            not part of ``time_to_first`` / ``time_to_stop``.
         tree_points, tree_parents: ``(N, 2)`` and ``(N,)`` (parent index, -1 for the
             root) when ``keep_tree`` was asked, else None.
     """
@@ -70,6 +72,7 @@ class PlanResult:
     target_cost: float | None = None
     milestones: tuple[Milestone, ...] = ()
     fallback_uniform: bool = False
+    setup_time: float = 0.0
     tree_points: np.ndarray | None = field(default=None, repr=False)
     tree_parents: np.ndarray | None = field(default=None, repr=False)
 

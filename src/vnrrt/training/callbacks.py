@@ -1,6 +1,6 @@
 """Lightning callbacks of the training runs: progress in logs, and the per-epoch figure.
 
-* :func:`progress_callbacks`: a live tqdm bar on a terminal; in non-TTY logs (``dvc repro >
+* :func:`progress_callback`: a live tqdm bar on a terminal; in non-TTY logs (``dvc repro >
   log``, CI) no bar but one :class:`LogProgress` line every ``every_n_steps`` steps and one
   per validation.
 * :class:`PredictionFigures`: after each validation epoch, input, ground truth and predicted
@@ -50,11 +50,12 @@ class LogProgress(Callback):
         log.info("epoch %d validation: %s", trainer.current_epoch, text)
 
 
-def progress_callbacks(every_n_steps: int = 50) -> tuple[list[Callback], bool]:
-    """(callbacks, enable_progress_bar): a tqdm bar on a TTY, else :class:`LogProgress`."""
+def progress_callback(every_n_steps: int = 50) -> Callback:
+    """A tqdm bar on a terminal, else :class:`LogProgress` (the ``callbacks.progress`` entry;
+    the training stage enables Lightning's bar only for the former)."""
     if sys.stderr.isatty():
-        return [TQDMProgressBar(refresh_rate=1)], True
-    return [LogProgress(every_n_steps)], False
+        return TQDMProgressBar(refresh_rate=1)
+    return LogProgress(every_n_steps)
 
 
 class PredictionFigures(Callback):
@@ -77,15 +78,16 @@ class PredictionFigures(Callback):
         loggers = [lg for lg in trainer.loggers if isinstance(lg, MLFlowLogger)]
         if self._kept is None or not loggers:
             return
-        from vnrrt import viz
         from vnrrt.maps.render import colorize
+        from vnrrt.viz.common import close
+        from vnrrt.viz.training import prediction_figure
 
         k = self._kept
         titles = [f"shard {s}, instance {i}" for s, i in k["key"]]
-        fig = viz.prediction_figure(colorize(k["classes"]), k["target"], k["vertices"],
-                                    k["probs"], titles)  # fmt: skip
+        fig = prediction_figure(colorize(k["classes"]), k["target"], k["vertices"], k["probs"],
+                                titles)  # fmt: skip
         name = f"figures/val_epoch_{trainer.current_epoch:03d}.png"
         for lg in loggers:
             lg.experiment.log_figure(lg.run_id, fig, name)
-        viz.close(fig)
+        close(fig)
         self._kept = None
