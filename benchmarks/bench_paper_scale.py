@@ -9,7 +9,7 @@ Measured here, each in the same run:
   images/s and inference ms per map; on a CUDA GPU, when there is one, bf16 channels_last
   training and inference images/s;
 * planner trials: mean seconds per trial for every (map kind, stop rule, planner) of a
-  trial table (default: the last ``dvc repro``'s ``reports/eval/trials``); the stricter
+  trial table (default: the last ``dvc repro``'s ``data/quick/trials.csv``); the stricter
   any-angle stop, absent from quick-scale tables, from the ``optimal`` trials times the
   any-angle / A* time ratio of uniform RRT* measured on a few of the table's instances.
 
@@ -38,8 +38,9 @@ from vnrrt.data.build import build_shard
 from vnrrt.data.config import LabelsConfig
 from vnrrt.data.datamodule import InstanceDataset
 from vnrrt.data.shards import shard_file
-from vnrrt.evaluation.evaluate import EvalConfig, planner_specs, read_trials, trial_counts
-from vnrrt.evaluation.report import check_trials
+from vnrrt.evaluation.config import EvalConfig
+from vnrrt.evaluation.protocol import planner_specs, trial_counts
+from vnrrt.evaluation.table import read_table
 from vnrrt.maps.config import DataConfig
 from vnrrt.model import VertexNet
 from vnrrt.parallel import n_workers
@@ -87,7 +88,7 @@ def network_rates(batch: int, steps: int, device: torch.device) -> dict[str, flo
 
 def trial_seconds(trials: pd.DataFrame) -> pd.Series:
     """Mean seconds per trial by (kind, stop, key); a failed trial counts its budget used."""
-    t = check_trials(trials)
+    t = trials.copy()
     t["kind"] = np.where(t["map_set"] == "random", "random", "named")
     return t.groupby(["kind", "stop", "key"])["time_to_stop"].mean()
 
@@ -120,8 +121,8 @@ def trials_hours(per_trial: pd.Series, ratio: float, cfg) -> tuple[float, int, l
     """Core-hours and trial count of the paper protocol (``cfg``: the paper config), and the
     planner configurations whose rate was borrowed."""
     ev = section(cfg, "eval", EvalConfig)
-    specs = planner_specs(ev, section(cfg, "planner", PlannerConfig),
-                          {n: cfg.networks[n].target for n in cfg.networks})  # fmt: skip
+    planner = section(cfg, "planner", PlannerConfig)
+    specs = planner_specs(ev, [*planner.taus, planner.tau])
     n_inst = {"named": 5, "random": ev.random_maps}
     seconds, count, borrowed = 0.0, 0, set()
     for (kind, stop), per_instance in trial_counts(ev).items():
@@ -159,8 +160,8 @@ def main() -> None:
                    help="training images/s of one GPU, when none is here to measure")  # fmt: skip
     p.add_argument("--gpu-infer-img-s", type=float, default=4500.0,
                    help="inference images/s of one GPU, when none is here to measure")  # fmt: skip
-    p.add_argument("--trials", default="reports/eval/trials", help="trial table directory")
-    p.add_argument("--shards", default="data/shards", help="shards of that table")
+    p.add_argument("--trials", default="data/quick/trials.csv", help="merged trial table")
+    p.add_argument("--shards", default="data/quick/shards", help="shards of that table")
     p.add_argument("--maps", type=int, default=10, help="maps labelled for the rate")
     args = p.parse_args()
     here = n_workers(0)  # this machine's cores (torch uses them all)
@@ -176,14 +177,13 @@ def main() -> None:
     else:
         gpu_train, gpu_infer = args.gpu_train_img_s, args.gpu_infer_img_s
         gpu_note = "ASSUMED (no GPU here): --gpu-train-img-s / --gpu-infer-img-s"
-    parts = sorted(int(f.stem.split("_")[1]) for f in Path(args.trials).glob("part_*.csv"))
-    table = read_trials(args.trials, parts)
+    table = read_table(args.trials)
     ratio = any_angle_ratio(table, Path(args.shards), 8)
     hours, n_trials, borrowed = trials_hours(trial_seconds(table), ratio, cfg)
 
     instances = len(cfg.scale.shards) * cfg.scale.maps_per_shard * 144
     train_items = instances * cfg.data.train_fraction * cfg.trainer.max_epochs
-    eval_maps = (cfg.predict.test_instances + 5) * len(cfg.predict.networks)
+    eval_maps = (cfg.eval.random_maps + 5) * len(cfg.predict.networks)
     setups = [tuple(int(v) for v in item.split(":")) for item in args.setups.split(",")]
 
     def stage_seconds(c: int, g: int) -> list[float]:

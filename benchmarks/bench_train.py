@@ -21,6 +21,7 @@ import time
 from pathlib import Path
 
 import lightning as L
+import numpy as np
 import torch
 from hydra.utils import instantiate
 
@@ -30,7 +31,7 @@ from vnrrt.data.config import LabelsConfig
 from vnrrt.data.manifest import build_manifest
 from vnrrt.data.shards import shard_file
 from vnrrt.maps.config import DataConfig
-from vnrrt.predict import predict_dataset
+from vnrrt.predict.batch import predict
 
 
 class StepTimer(L.Callback):
@@ -89,7 +90,8 @@ def bench(args: argparse.Namespace, overrides: list[str], device: torch.device) 
             break
     loader = n / (time.perf_counter() - start)
     data = dm.datasets["test"]
-    _, sec = predict_dataset(net.eval(), data, args.batch, device)
+    images = np.stack([data[i]["image"].numpy() for i in range(len(data))])
+    _, sec = predict(net.eval(), images, args.batch, device)
     return {"pipeline": pipeline, "baseline": baseline, "loader": loader, "ms_per_map": 1e3 * sec,
             "params": sum(p.numel() for p in net.parameters())}  # fmt: skip
 

@@ -120,6 +120,11 @@ def test_smoke_dvc_repro_end_to_end(workdir):
         "## Time to within (1 + eps) of the exact continuous optimum",
     ):
         assert text in report, text
+    ideas = (workdir / "reports/sampling_ideas.md").read_text()
+    for text in ("## Conclusion", "## Oracles, within 1% of A*", "## The heatmap-quality curve",
+                 "## The planner regime", "VNRRT* [oracle_vertex]"):
+        assert text in ideas, text
+    assert (workdir / "reports/figures/ideas/quality_curve.png").stat().st_size > 10_000
     headline = json.loads((workdir / "reports/metrics/headline.json").read_text())
     assert sum(headline["verdicts"].values()) == 16
     client = MlflowClient(f"sqlite:///{workdir / 'mlflow.db'}")
@@ -191,7 +196,8 @@ def test_an_evaluation_only_experiment_reruns_only_the_evaluation(workdir):
         ["dvc", "exp", "run", "-S", "scale=smoke", "-S", "seed=1", "-S", "planner.tau=0.7"], workdir
     )
     ran = sorted(line.split("'")[1] for line in out.splitlines() if "Running stage" in line)
-    assert ran == ["evaluate", "report", "trials@0", "trials@1", "validate"], out
+    evaluation = ["evaluate", "ideas", "oracle@0", "regime@0", "report", "trials@0", "trials@1"]
+    assert ran == [*evaluation, "validate"], out
     table = pd.read_csv(workdir / "data/smoke/trials.csv")
     assert "m_vnrrt_star@0.7" in set(table["key"])
 

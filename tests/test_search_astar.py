@@ -4,7 +4,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given
+from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import dijkstra
@@ -139,3 +139,50 @@ def test_bad_input_errors_name_the_problem():
         astar(np.zeros((4, 4, 1), np.uint8), (0, 0), (1, 1))
     with pytest.raises(GridError, match="dtype"):
         astar(grid.astype(float), (0, 0), (1, 1))
+
+
+def detour_grid(rng: np.random.Generator, h: int, w: int) -> np.ndarray:
+    """Walls across the map with one or two gaps each, plus clutter: the greedy direction
+    to the goal is wrong and the optimal path detours, so the heuristic decides what A*
+    expands (random sparse grids rarely show a bad heuristic)."""
+    grid = (rng.random((h, w)) < 0.08).astype(np.uint8)
+    for _ in range(int(rng.integers(2, 5))):
+        if rng.random() < 0.5:
+            x = int(rng.integers(2, w - 2))
+            grid[:, x] = 1
+            for _ in range(int(rng.integers(1, 3))):
+                y = int(rng.integers(0, h - 2))
+                grid[y : y + 2, x] = 0
+        else:
+            y = int(rng.integers(2, h - 2))
+            grid[y, :] = 1
+            for _ in range(int(rng.integers(1, 3))):
+                x = int(rng.integers(0, w - 2))
+                grid[y, x : x + 2] = 0
+    return grid
+
+
+@settings(max_examples=150)
+@given(st.integers(0, 10**6))
+def test_astar_is_optimal_where_the_heuristic_matters(seed):
+    """Mutations of vnrrt.search.astar this test must catch (each checked once by hand and
+    by tests/test_search_astar_mutations.py, slow):
+
+    * an overestimating heuristic, ``max + min`` instead of ``max + (sqrt 2 - 1) min``;
+    * diagonal moves costing 1 instead of sqrt 2;
+    * corner cutting allowed (the orthogonal-neighbour check removed);
+    * improvements refused unless better by more than 1 px.
+    """
+    rng = np.random.default_rng(seed)
+    h, w = int(rng.integers(20, 60)), int(rng.integers(20, 60))
+    grid = detour_grid(rng, h, w)
+    free = np.argwhere(grid == 0)
+    for _ in range(3):
+        (sy, sx), (gy, gx) = free[rng.choice(len(free), 2, replace=False)]
+        ref = dijkstra(reference_graph(grid), indices=sy * w + sx)[gy * w + gx]
+        if not np.isfinite(ref):
+            continue
+        path, length = astar(grid, (int(sx), int(sy)), (int(gx), int(gy)))
+        assert length == pytest.approx(ref, abs=1e-9)
+        assert path_length(path) == pytest.approx(ref, abs=1e-9)
+        assert_valid_path(grid, path, (sx, sy), (gx, gy))

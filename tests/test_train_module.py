@@ -10,7 +10,7 @@ from hydra.utils import instantiate
 
 from tests.train_helpers import QUICK, paths, small_cfg
 from vnrrt.config import compose
-from vnrrt.model.checkpoint import CheckpointError, load_network, read_checkpoint
+from vnrrt.model.checkpoint import CheckpointError, checksum_file, load_network, read_checkpoint
 from vnrrt.model.metrics import VertexRecall
 from vnrrt.training.callbacks import LogProgress
 from vnrrt.training.stage import run_train as train
@@ -52,8 +52,9 @@ def test_overfitting_a_handful_of_instances_drives_vertex_recall_up(small_data, 
 
 
 def test_a_resumed_run_ends_where_an_uninterrupted_one_does(small_data, tmp_path, monkeypatch):
-    """Stop a 2-epoch run after epoch 0, resume it from its last.ckpt: same steps, same
-    schedule, same batches, hence the same final weights as a run never stopped."""
+    """Kill a 2-epoch run after epoch 0 and run the stage again: it resumes by itself from
+    its last.ckpt (same settings), so steps, schedule, batches and the final weights equal
+    those of a run never stopped; the folder of last.ckpt is gone after success."""
     two = [*QUICK, "trainer.max_epochs=2", "train.module.scheduler.pct_start=0.5"]
     full = train(small_cfg(small_data, tmp_path / "full", *two), "vertexnet")
 
@@ -61,20 +62,50 @@ def test_a_resumed_run_ends_where_an_uninterrupted_one_does(small_data, tmp_path
         if trainer.current_epoch == 1:
             raise RuntimeError("interrupted")
 
+    cut = small_cfg(small_data, tmp_path / "cut", *two)
     with monkeypatch.context() as m:
         m.setattr(LogProgress, "on_train_epoch_start", crash)
         with pytest.raises(RuntimeError, match="interrupted"):
-            train(small_cfg(small_data, tmp_path / "cut", *two), "vertexnet")
-    last = tmp_path / "last.ckpt"
-    shutil.copy(tmp_path / "cut" / "models" / "checkpoints" / "vertexnet" / "last.ckpt", last)
+            train(cut, "vertexnet")
+    last = tmp_path / "cut" / "models" / "checkpoints" / "vertexnet" / "last.ckpt"
     assert read_checkpoint(last)["global_step"] == 2
-    resumed = train(small_cfg(small_data, tmp_path / "cut", *two,
-                              f"networks.vertexnet.resume={last}"), "vertexnet")  # fmt: skip
+    resumed = train(cut, "vertexnet")  # the same stage again, nothing said about resuming
     assert resumed["steps"] == full["steps"] == 4 and resumed["epochs"] == 2
     want = read_checkpoint(tmp_path / "full" / "models" / "vertexnet.ckpt")["state_dict"]
     got = read_checkpoint(tmp_path / "cut" / "models" / "vertexnet.ckpt")["state_dict"]
     for key, value in want.items():
         torch.testing.assert_close(got[key], value, msg=key)
+    assert not last.parent.exists()
+
+
+def test_a_last_checkpoint_of_other_settings_is_not_resumed(small_data, tmp_path, caplog):
+    cfg = small_cfg(small_data, tmp_path, *QUICK)
+    train(cfg, "vertexnet")
+    last = tmp_path / "models" / "checkpoints" / "vertexnet" / "last.ckpt"
+    last.parent.mkdir(parents=True)
+    shutil.copy(tmp_path / "models" / "vertexnet.ckpt", last)  # as if left by another run
+    other = small_cfg(small_data, tmp_path, *QUICK, "train.module.optimizer.lr=0.5")
+    with caplog.at_level("WARNING"):
+        metrics = train(other, "vertexnet")
+    assert "restarting vertexnet from scratch" in caplog.text and metrics["steps"] == 2
+
+
+def test_stale_running_runs_of_the_stage_are_marked_killed(small_data, tmp_path, monkeypatch):
+    """A SIGKILLed training cannot end its MLflow run; the next run of that stage does."""
+    from mlflow import MlflowClient
+
+    from vnrrt import tracking
+
+    monkeypatch.setenv("DVC_STAGE", "train@vertexnet")
+    cfg = small_cfg(small_data, tmp_path, *QUICK, "logger.enabled=true", "logger.log_model=false")
+    uri = f"sqlite:///{tmp_path}/mlflow.db"
+    exp = tracking.experiment_id(cfg.logger.experiment, uri)
+    client = MlflowClient(uri)
+    stale = client.create_run(exp, tags=tracking.run_tags("vertexnet", "smoke"))
+    other = client.create_run(exp, tags=tracking.run_tags("nrrtnet", "smoke"))
+    train(cfg, "vertexnet")
+    assert client.get_run(stale.info.run_id).info.status == "KILLED"
+    assert client.get_run(other.info.run_id).info.status == "RUNNING"  # another stage's
 
 
 @pytest.mark.parametrize(
@@ -113,3 +144,23 @@ def test_loading_checks_the_network_and_the_weights(trained, tmp_path):
     torch.save(ckpt, tmp_path / "foreign.ckpt")
     with pytest.raises(CheckpointError, match="not written by vnrrt.train"):
         load_network(tmp_path / "foreign.ckpt")
+
+
+def test_a_bit_flipped_checkpoint_is_refused(trained, tmp_path):
+    """The training stage records each checkpoint's sha256 beside it; 4 KiB of flipped bytes
+    inside the tensors load as garbage weights, but the prediction stage (verify=True)
+    refuses them."""
+    good = trained / "models" / "vertexnet.ckpt"
+    assert checksum_file(good).is_file()
+    load_network(good, "vertexnet", verify=True)
+    bad = tmp_path / "vertexnet.ckpt"
+    data = bytearray(good.read_bytes())
+    middle = len(data) // 2
+    data[middle : middle + 4096] = bytes(b ^ 0xFF for b in data[middle : middle + 4096])
+    bad.write_bytes(bytes(data))
+    shutil.copy(checksum_file(good), checksum_file(bad))
+    with pytest.raises(CheckpointError, match="does not match its recorded sha256"):
+        load_network(bad, "vertexnet", verify=True)
+    checksum_file(bad).unlink()
+    with pytest.raises(CheckpointError, match="has no recorded sha256"):
+        load_network(bad, "vertexnet", verify=True)

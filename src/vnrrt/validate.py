@@ -2,8 +2,8 @@
 
 Used by the ``validate`` DVC stage (:func:`run_validate`), which every other stage depends
 on (so ``dvc repro`` and ``dvc exp run -S ...`` stop on a bad value before the first shard
-is written), by ``python -m vnrrt.params`` (``make params``) and by the Hydra multirun jobs. Each section is
-checked against its typed dataclass; cross-section rules follow. Errors are
+is written), by ``python -m vnrrt.params`` (``make params``) and by the Hydra multirun jobs.
+Each section is checked against its typed dataclass; cross-section rules follow. Errors are
 :class:`vnrrt.config.ConfigError` naming the key.
 """
 
@@ -14,6 +14,8 @@ from omegaconf import DictConfig
 from vnrrt.config import ConfigError, check, check_parts, section
 from vnrrt.data.config import LabelsConfig, ScaleConfig
 from vnrrt.evaluation.config import EvalConfig, StatsConfig
+from vnrrt.evaluation.protocol import parse_key
+from vnrrt.evaluation.study import OracleConfig, RegimeConfig
 from vnrrt.maps.config import DataConfig
 from vnrrt.planners.config import PlannerConfig
 
@@ -68,6 +70,8 @@ def validate_config(cfg: DictConfig) -> dict:
         "planner": section(cfg, "planner", PlannerConfig),
         "eval": section(cfg, "eval", EvalConfig),
         "stats": section(cfg, "stats", StatsConfig),
+        "oracle": section(cfg, "oracle", OracleConfig),
+        "regime": section(cfg, "regime", RegimeConfig),
     }
     _taus(typed["planner"])
     networks = _networks(cfg)
@@ -79,6 +83,10 @@ def validate_config(cfg: DictConfig) -> dict:
             f"must name a network of `networks` ({sorted(networks)})",
         )
     _random_maps(typed["eval"], typed["data"], typed["scale"])
+    for key in typed["regime"].configurations:
+        spec = parse_key(key, typed["eval"].sources)
+        ok = spec.source is None or spec.source.startswith("oracle_") or spec.source in networks
+        check(ok, "regime.configurations", key, f"its source must be a network {sorted(networks)}")
     check_parts(cfg.get("predict", {}).get("parts", [0]), "predict.parts")
     seed = cfg.get("seed")
     check(isinstance(seed, int) and seed >= 0, "seed", seed, "must be an integer >= 0")

@@ -175,12 +175,14 @@ def load(
     networks: list[str],
     heatmaps_dir: str | Path | None = None,
     parts: list[int] | None = None,
-) -> dict[int, EvalInstance]:
+) -> tuple[dict[int, EvalInstance], dict[str, str]]:
     """``{index: instance}`` for ``indices`` of the instances file, each with the heatmaps of
     ``networks`` (read from the ``predict@<k>`` part files of ``parts``, which must cover
-    exactly the file's instances, in order)."""
+    exactly the file's instances, in order), and each network's target (``'path'`` or
+    ``'interior_vertices'``, from the files' record of what the network was trained on)."""
     inst = Instances(path)
     maps: dict[str, np.ndarray] = {}
+    targets: dict[str, str] = {}
     if networks:
         from vnrrt.data.heatmaps import HeatmapError, read_parts
 
@@ -194,8 +196,11 @@ def load(
         if missing:
             raise HeatmapError(f"heatmaps in {heatmaps_dir} have no network {missing}")
         maps = {n: files["maps"][n] for n in networks}
+        for n in networks:
+            kind = files["meta"][0].get("networks", {}).get(n, {}).get("target", {}).get("kind")
+            targets[n] = "interior_vertices" if kind == "vertex" else "path"
     out = {}
     for i in indices:
         heat = {n: m[i].astype(np.float32) for n, m in maps.items()}
         out[i] = dataclasses.replace(inst[i], heatmaps=heat)
-    return out
+    return out, targets

@@ -137,7 +137,8 @@ def oracle_heatmap(
     occ = as_occupancy(grid)
     s, g = as_cell(occ, start, "start"), as_cell(occ, goal, "goal")
     path, _ = astar(occ, s, g)
-    exact, _ = any_angle_path(occ, cell_center(np.array([s])), cell_center(np.array([g])))
+    centres = cell_center(np.array([s, g]))
+    exact, _ = any_angle_path(occ, centres[0], centres[1])
     return finish(target_image(kind, occ.shape, path, exact), occ, sigma, floor)
 
 
@@ -175,3 +176,32 @@ def instance_heatmap(source: str, inst, sigma: float = 1.0, floor: float = 0.0) 
     img = target_image(kind, inst.grid.shape, inst.path, inst.exact_path, inst.vertices)
     heat = finish(img, inst.grid, sigma, floor)
     return heat if q == 1.0 else mix(heat, inst.grid, q)
+
+
+def target_mask(inst, target: str) -> np.ndarray:
+    """``(H, W)`` bool cells of an instance's ``target``: ``'path'`` (the A* path),
+    ``'vertices'`` (its vertices), ``'interior_vertices'`` (without start and goal) or
+    ``'endpoints'`` (start and goal)."""
+    cells = {
+        "path": inst.path,
+        "vertices": inst.vertices,
+        "interior_vertices": inst.vertices[1:-1],
+        "endpoints": inst.path[[0, -1]],
+    }[target]
+    mask = np.zeros(inst.grid.shape, bool)
+    cells = np.asarray(cells, np.int64).reshape(-1, 2)
+    mask[cells[:, 1], cells[:, 0]] = True
+    return mask
+
+
+def mass_near(heatmap: np.ndarray, mask: np.ndarray, radius: float) -> float:
+    """Share of ``heatmap``'s mass within ``radius`` px of a True cell of ``mask`` (the
+    metric the networks report, :class:`vnrrt.model.metrics.MassNear`); NaN when the mask
+    is empty or the heatmap has no mass."""
+    from vnrrt.data.targets import dilate
+
+    h = np.asarray(heatmap, np.float64)
+    total = h.sum()
+    if not mask.any() or total <= 0:
+        return math.nan
+    return float(h[dilate(mask, radius)].sum() / total)

@@ -34,18 +34,10 @@ KINDS = ("named", "random")
 TRIALS_PER_JOB = 25
 
 
-def planner_key(
-    planner: str,
-    tau: float | None = None,
-    source: str | None = None,
-    default_source: str | None = None,
-) -> str:
-    """Row key of a configuration: ``vnrrt_star``, ``m_vnrrt_star@0.5``, or with a heatmap
-    source other than the planner's default one ``vnrrt_star[oracle_vertex]``."""
-    key = planner if tau is None or tau != tau else f"{planner}@{tau:g}"
-    if source is not None and source != default_source:
-        key += f"[{source}]"
-    return key
+def planner_key(planner: str, tau: float | None = None) -> str:
+    """Row key of a configuration: ``vnrrt_star`` or ``m_vnrrt_star@0.5`` (a heatmap source
+    other than the protocol's is appended as ``[source]``: :func:`with_source`)."""
+    return planner if tau is None or tau != tau else f"{planner}@{tau:g}"
 
 
 @dataclass(frozen=True)
@@ -112,11 +104,32 @@ def trial_seed(seed: int, instance: int, stop: str, trial: int) -> int:
     return int(ss.generate_state(1, np.uint64)[0] >> np.uint64(1))
 
 
+def parse_key(key: str, sources: dict[str, str] | None = None) -> PlannerSpec:
+    """The configuration a row key names: ``rrt_star``, ``m_vnrrt_star@0.5``, or with a
+    heatmap source ``vnrrt_star[oracle_vertex]`` (a network name or an oracle); without one,
+    a learned planner samples its source in ``sources`` (``eval.sources``)."""
+    base, _, source = key.partition("[")
+    planner, _, tau = base.partition("@")
+    if source and not source.endswith("]"):
+        raise ConfigError(f"bad configuration {key!r}: expected planner[@tau][[source]]")
+    src = source[:-1] or (sources or {}).get(planner)
+    try:
+        return PlannerSpec(planner, float(tau) if tau else None, src, key)
+    except ValueError as err:
+        raise ConfigError(f"bad configuration {key!r}: {err}") from None
+
+
+def with_source(spec: PlannerSpec, source: str) -> PlannerSpec:
+    """``spec`` sampling ``source`` instead, keyed ``<planner>[@tau][<source>]``."""
+    key = f"{planner_key(spec.planner, spec.tau)}[{source}]"
+    return PlannerSpec(spec.planner, spec.tau, source, key)
+
+
 @dataclass(frozen=True)
 class TrialJob:
-    """Trials ``first .. first + count - 1`` of one (instance, configuration, stop); their
-    rows are ``seq .. seq + count - 1`` of the whole protocol's table (canonical order:
-    instance, configuration, stop, trial)."""
+    """Trials ``first .. first + count - 1`` of one (instance, configuration, stop[, regime
+    cell]); their rows are ``seq .. seq + count - 1`` of the whole table (canonical order:
+    regime cell, instance, configuration, stop, trial)."""
 
     instance: int
     spec: PlannerSpec
@@ -124,6 +137,7 @@ class TrialJob:
     first: int
     count: int
     seq: int
+    regime: str = ""
 
 
 def trial_jobs(
@@ -131,18 +145,23 @@ def trial_jobs(
     specs: list[PlannerSpec],
     counts: dict[tuple[str, str], int],
     per_job: int = TRIALS_PER_JOB,
+    regimes: tuple[str, ...] = ("",),
+    instances: list[int] | None = None,
 ) -> list[TrialJob]:
-    """Every job of the protocol in canonical order; ``kinds[i]`` is ``'named'`` or
-    ``'random'`` for instance ``i`` and ``counts`` as :func:`trial_counts` returns."""
+    """Every job in canonical order; ``kinds[i]`` is ``'named'`` or ``'random'`` for
+    instance ``i``, ``counts`` as :func:`trial_counts` returns; ``instances`` restricts the
+    instances (default: all) and ``regimes`` repeats everything per regime-sweep cell."""
     jobs, seq = [], 0
-    for i, kind in enumerate(kinds):
-        for spec in specs:
-            for stop in STOPS:
-                n = counts.get((kind, stop), 0)
-                for first in range(0, n, per_job):
-                    count = min(per_job, n - first)
-                    jobs.append(TrialJob(i, spec, stop, first, count, seq))
-                    seq += count
+    chosen = range(len(kinds)) if instances is None else instances
+    for regime in regimes:
+        for i in chosen:
+            for spec in specs:
+                for stop in STOPS:
+                    n = counts.get((kinds[i], stop), 0)
+                    for first in range(0, n, per_job):
+                        count = min(per_job, n - first)
+                        jobs.append(TrialJob(i, spec, stop, first, count, seq, regime))
+                        seq += count
     return jobs
 
 

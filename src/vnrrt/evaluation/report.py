@@ -211,7 +211,9 @@ def build_report(
     parts = [
         "# VertexNet RRT*: the paper's tables beside this reproduction",
         "",
-        f"Made at scale `{scale}` (`conf/scale/{scale}.yaml`); eps = {eps:g}.",
+        f"Made at scale `{scale}` (`conf/scale/{scale}.yaml`); eps = {eps:g}. What a perfect "
+        "network would give each sampling idea, and in which planner regime: "
+        "[sampling_ideas.md](sampling_ideas.md).",
         "",
         RULES,
         "",

@@ -16,6 +16,7 @@ dependencies are what it runs.
 from __future__ import annotations
 
 import logging
+from pathlib import Path
 
 from omegaconf import DictConfig
 
@@ -60,7 +61,7 @@ def run_trials_part(cfg: DictConfig, part: int) -> int:
     from vnrrt.evaluation.instances import Instances, load
     from vnrrt.evaluation.protocol import part_jobs, trial_jobs
     from vnrrt.evaluation.table import part_file, write_table
-    from vnrrt.evaluation.trials import run_jobs
+    from vnrrt.evaluation.trials import HeatSettings, run_jobs
     from vnrrt.planners.config import PlannerConfig
 
     ev, specs, counts = _protocol(cfg)
@@ -72,11 +73,12 @@ def run_trials_part(cfg: DictConfig, part: int) -> int:
     networks = sorted({s.source for s in specs if s.source is not None})
     indices = sorted({job.instance for job in jobs})
     parts = check_parts(cfg.predict.parts, "predict.parts")
-    instances = load(cfg.paths.instances, indices, networks, cfg.paths.heatmaps, parts)
+    instances, targets = load(cfg.paths.instances, indices, networks, cfg.paths.heatmaps, parts)
     log.info(
         "part %d/%d: %d trial jobs on %d instances", part, len(ev.parts), len(jobs), len(instances)
     )
-    table = run_jobs(jobs, instances, int(cfg.seed), int(cfg.workers), planner)
+    heat = HeatSettings(radius=float(cfg.oracle.radius), targets=targets)
+    table = run_jobs(jobs, instances, int(cfg.seed), int(cfg.workers), planner, heat)
     write_table(table, part_file(cfg.paths.trials, part))
     return len(table)
 
@@ -129,3 +131,138 @@ def run_report(cfg: DictConfig):
     from vnrrt.evaluation.stage_report import report
 
     return report(cfg)
+
+
+def _random_instances(path, n: int) -> tuple[list[str], list[int]]:
+    """The instance kinds of the instances file and its first ``n`` random instances."""
+    from vnrrt.evaluation.instances import Instances
+
+    kinds = Instances(path).kinds
+    return kinds, [i for i, k in enumerate(kinds) if k == "random"][:n]
+
+
+def _run_study(cfg: DictConfig, part: int, which: str) -> int:
+    """A part of the oracle study (``which='oracle'``) or of the regime sweep ->
+    ``<paths.<which>>/part_<part>.csv``; returns the number of trials."""
+    from vnrrt.config import ConfigError, check_parts
+    from vnrrt.evaluation.instances import load
+    from vnrrt.evaluation.protocol import parse_key, part_jobs, trial_jobs
+    from vnrrt.evaluation.study import (
+        OracleConfig,
+        RegimeConfig,
+        oracle_counts,
+        oracle_specs,
+        regime_cells,
+        regime_counts,
+    )
+    from vnrrt.evaluation.table import part_file, write_table
+    from vnrrt.evaluation.trials import HeatSettings, run_jobs
+    from vnrrt.planners.config import PlannerConfig
+
+    ev = EvalConfig(planners=list(cfg.eval.planners), sources=dict(cfg.eval.sources))
+    oc, planner = section(cfg, "oracle", OracleConfig), section(cfg, "planner", PlannerConfig)
+    taus = [*planner.taus, planner.tau]
+    if which == "oracle":
+        parts, n, specs = oc.parts, oc.random_maps, oracle_specs(oc, taus, ev.sources)
+        counts, configs = oracle_counts(oc), {"": planner}
+    else:
+        rc = section(cfg, "regime", RegimeConfig)
+        parts, n, counts = rc.parts, rc.random_maps, regime_counts()
+        specs = [parse_key(k, ev.sources) for k in rc.configurations]
+        configs = {label: planner.replace(**over) for label, over in regime_cells(rc).items()}
+    if part not in parts:
+        raise ConfigError(f"part {part} is not in {which}.parts {parts}")
+    kinds, chosen = _random_instances(cfg.paths.instances, n)
+    jobs = trial_jobs(kinds, specs, counts, regimes=tuple(configs), instances=chosen)
+    jobs = part_jobs(jobs, part, len(parts))
+    networks = sorted({s.source for s in specs if s.source and not s.source.startswith("oracle")})
+    indices = sorted({job.instance for job in jobs})
+    predict_parts = check_parts(cfg.predict.parts, "predict.parts")
+    instances, targets = load(
+        cfg.paths.instances, indices, networks, cfg.paths.heatmaps, predict_parts
+    )
+    heat = HeatSettings(oc.sigma, oc.floor, oc.radius, targets)
+    log.info(
+        "%s part %d/%d: %d jobs on %d instances", which, part, len(parts), len(jobs), len(instances)
+    )
+    table = run_jobs(jobs, instances, int(cfg.seed), int(cfg.workers), configs, heat)
+    write_table(table, part_file(cfg.paths[which], part))
+    return len(table)
+
+
+def run_oracle_part(cfg: DictConfig, part: int) -> int:
+    """Stage ``oracle@<part>``: part of the oracle study (:mod:`vnrrt.evaluation.study`)."""
+    return _run_study(cfg, part, "oracle")
+
+
+def run_regime_part(cfg: DictConfig, part: int) -> int:
+    """Stage ``regime@<part>``: part of the regime sweep (:mod:`vnrrt.evaluation.study`)."""
+    return _run_study(cfg, part, "regime")
+
+
+def run_ideas(cfg: DictConfig) -> dict:
+    """Stage ``ideas``: the oracle and regime parts merged (checked complete), their
+    statistics, ``sampling_ideas.md`` and its figures."""
+    from vnrrt.evaluation.ideas_report import build_ideas_report
+    from vnrrt.evaluation.protocol import parse_key, planner_specs, trial_jobs
+    from vnrrt.evaluation.study import (
+        OracleConfig,
+        RegimeConfig,
+        oracle_counts,
+        oracle_specs,
+        regime_cells,
+        regime_counts,
+    )
+    from vnrrt.evaluation.study_analysis import analyze_study
+    from vnrrt.evaluation.table import merge_parts
+    from vnrrt.io import write_json, write_text
+    from vnrrt.viz.ideas import save_quality, save_regime
+
+    ev = EvalConfig(planners=list(cfg.eval.planners), sources=dict(cfg.eval.sources))
+    oc, rc = section(cfg, "oracle", OracleConfig), section(cfg, "regime", RegimeConfig)
+    st = section(cfg, "stats", StatsConfig)
+    taus = [*cfg.planner.taus, cfg.planner.tau]
+    kinds, chosen = _random_instances(cfg.paths.instances, oc.random_maps)
+    jobs = trial_jobs(
+        kinds, oracle_specs(oc, taus, ev.sources), oracle_counts(oc), instances=chosen
+    )
+    n_oracle = sum(j.count for j in jobs)
+    oracle = merge_parts(cfg.paths.oracle, oc.parts, n_oracle)
+    specs = [parse_key(k, ev.sources) for k in rc.configurations]
+    _, chosen = _random_instances(cfg.paths.instances, rc.random_maps)
+    cells = tuple(regime_cells(rc))
+    jobs = trial_jobs(kinds, specs, regime_counts(), regimes=cells, instances=chosen)
+    n_regime = sum(j.count for j in jobs)
+    regime = merge_parts(cfg.paths.regime, rc.parts, n_regime)
+    networks = [s.key for s in planner_specs(ev, taus) if s.source]
+    summary = analyze_study(oracle, regime, networks, st.bootstrap, st.level)
+    write_json(cfg.paths.ideas_summary, summary)
+    figs = Path(cfg.paths.figures) / "ideas"
+    import pandas as pd
+
+    curves, nets = pd.DataFrame(summary["curves"]), pd.DataFrame(summary["networks"])
+    written = []
+    if not curves.empty:
+        save_quality(figs / "quality_curve.png", curves, nets)
+        written.append("figures/ideas/quality_curve.png")
+    sweep = pd.DataFrame(summary["regime"])
+    for stop in ("optimal", "optimal_any_angle"):
+        if not sweep.empty and stop in set(sweep["stop"]):
+            save_regime(figs / f"regime_{stop}.png", sweep, stop, 0.01)
+            written.append(f"figures/ideas/regime_{stop}.png")
+    text = build_ideas_report(summary, str(cfg.scale.name), written)
+    write_text(cfg.paths.ideas_report, text)
+    if cfg.logger.enabled:
+        from vnrrt.evaluation.mlflow_runs import log_ideas
+
+        reports = Path(cfg.paths.ideas_report).parent
+        log_ideas(
+            cfg,
+            summary,
+            [
+                Path(cfg.paths.ideas_report),
+                Path(cfg.paths.ideas_summary),
+                *(reports / f for f in written),
+            ],
+        )
+    return summary

@@ -13,10 +13,12 @@ Rules (stated in the report as well):
   with the same trial seeds. The headline speed-up of a planner over a baseline is the
   geometric mean over instances of the per-instance ratio ``median(baseline) /
   median(planner)`` (iterations counted +1, so a root that sees the goal counts one step).
-  Its confidence interval comes from a two-stage bootstrap: base maps (clusters) are
-  resampled with replacement, then trials within each resampled instance (paired: trial t
-  of both configurations together). The paper's ratio of means is computed beside it with
-  the same resampling. Improvement = speed-up - 1 (the paper's ``baseline / planner - 1``).
+  Its confidence interval comes from a bootstrap over the three levels: base maps
+  (clusters) are resampled with replacement, then instances within each drawn map, then
+  trials within each instance (paired: trial t of both configurations together). A single
+  trial of a single instance has no interval (NaN). The paper's ratio of means is computed
+  beside it with the same resampling. Improvement = speed-up - 1 (the paper's
+  ``baseline / planner - 1``).
 * **Verdicts** (:func:`verdict`) compare a quoted improvement with our CI.
 
 Every bootstrap draws from a seeded generator, so reports are reproducible.
@@ -211,10 +213,7 @@ def compare(
     clusters = _codes(j.groupby("instance", sort=False)["cluster_b"].first().to_numpy())
     rng = np.random.default_rng(seed)
     idx = np.vstack([np.arange(len(b)), _within(inst, n_boot, rng)])  # row 0: the data
-    weights = np.vstack(
-        [np.ones(clusters.max() + 1), _cluster_weights(clusters.max() + 1, n_boot, rng)]
-    )
-    w_inst = weights[:, clusters]  # (1 + B, I)
+    w_inst = np.vstack([np.ones(len(clusters)), _instance_weights(clusters, n_boot, rng)])
     log_ratio = np.log(_group_medians(b[idx], inst)) - np.log(_group_medians(p[idx], inst))
     gm = np.exp((w_inst * log_ratio).sum(1) / w_inst.sum(1))
     sums_b, sums_p = _group_sums(b[idx], inst), _group_sums(p[idx], inst)
@@ -222,6 +221,8 @@ def compare(
     q = [(1 - level) / 2, (1 + level) / 2]
     lo, hi = np.quantile(gm[1:], q)
     rlo, rhi = np.quantile(rom[1:], q)
+    if len(clusters) == 1 and len(j) == 1:  # one trial of one instance: no interval
+        lo = hi = rlo = rhi = float("nan")
     return Comparison(
         float(gm[0]),
         float(lo),
@@ -235,6 +236,19 @@ def compare(
         int((~j["success_b"]).sum()),
         int((~j["success_p"]).sum()),
     )
+
+
+def _instance_weights(clusters: np.ndarray, n_boot: int, rng: np.random.Generator) -> np.ndarray:
+    """``(n_boot, I)`` how often each instance enters a resample: clusters (base maps) are
+    drawn with replacement, then instances with replacement within each drawn cluster.
+    ``clusters`` (I,) are the instances' cluster codes."""
+    n = len(clusters)
+    per_cluster = _cluster_weights(int(clusters.max()) + 1, n_boot, rng)[:, clusters]
+    order = np.argsort(clusters, kind="stable")
+    chosen = order[_within(clusters[order], n_boot, rng)]  # (B, I) instance ids
+    flat = (chosen + n * np.arange(n_boot)[:, None]).ravel()
+    within = np.bincount(flat, minlength=n_boot * n).reshape(n_boot, n)
+    return per_cluster * within
 
 
 def _group_medians(x: np.ndarray, groups: np.ndarray) -> np.ndarray:

@@ -58,6 +58,8 @@ class TrialRow:
     time_to_stop: float  # s until the stop rule or a budget
     setup_time: float  # s to build the sampler of this (instance, configuration), once
     convergence: tuple[float, ...] = ()  # s to CONVERGENCE_FACTORS x reference (optimal)
+    regime: str = ""  # planner settings of a regime-sweep cell ('' = the protocol's)
+    heat_mass: float = math.nan  # share of the heatmap's mass within r px of its target
 
     def record(self) -> dict:
         """The row as ``{column: value}`` (convergence times as ``t_<f>x`` columns)."""

@@ -18,17 +18,50 @@ from torch import nn
 from vnrrt.model.module import RECORD_KEY
 
 RECORD_FIELDS = ("network", "net", "target", "render")
+CHECKSUM_SUFFIX = ".sha256"  # <checkpoint>.sha256 beside each checkpoint the pipeline writes
 
 
 class CheckpointError(ValueError):
     """A checkpoint is missing, unreadable or does not fit the network it is used for."""
 
 
-def read_checkpoint(path: str | Path) -> dict[str, Any]:
-    """Load a checkpoint file on CPU (tensors and plain data only) and check its record."""
+def checksum_file(path: str | Path) -> Path:
+    """``<checkpoint>.sha256``: the checkpoint's recorded sha256."""
+    return Path(f"{path}{CHECKSUM_SUFFIX}")
+
+
+def write_checksum(path: str | Path) -> str:
+    """Record the checkpoint's sha256 beside it; returns the digest."""
+    from vnrrt.io import sha256, write_text
+
+    digest = sha256(path)
+    write_text(checksum_file(path), f"{digest}  {Path(path).name}\n")
+    return digest
+
+
+def verify_checksum(path: str | Path, required: bool = False) -> None:
+    """Raise :class:`CheckpointError` when the checkpoint's bytes do not match its recorded
+    sha256 (a corrupted or swapped file), or when ``required`` and none is recorded."""
+    from vnrrt.io import sha256
+
+    record = checksum_file(path)
+    if not record.is_file():
+        if required:
+            raise CheckpointError(f"checkpoint {path} has no recorded sha256 ({record})")
+        return
+    want = record.read_text().split()[0] if record.read_text().split() else ""
+    if sha256(path) != want:
+        raise CheckpointError(f"checkpoint {path} does not match its recorded sha256 ({record}): "
+                              "the file was modified or corrupted")  # fmt: skip
+
+
+def read_checkpoint(path: str | Path, verify: bool = False) -> dict[str, Any]:
+    """Load a checkpoint file on CPU (tensors and plain data only) and check its record; its
+    recorded sha256 too, where there is one (``verify``: there must be one)."""
     path = Path(path)
     if not path.is_file():
         raise CheckpointError(f"checkpoint {path} does not exist")
+    verify_checksum(path, required=verify)
     try:
         ckpt = torch.load(path, map_location="cpu", weights_only=True)
     except Exception as err:  # torch raises many types for corrupt or foreign files
@@ -81,10 +114,13 @@ def check_checkpoint(path: str | Path, record: dict, module: nn.Module) -> dict[
     return ckpt
 
 
-def load_network(path: str | Path, network: str | None = None) -> tuple[nn.Module, dict]:
+def load_network(
+    path: str | Path, network: str | None = None, verify: bool = False
+) -> tuple[nn.Module, dict]:
     """The trained network ``(B, 3, H, W) -> (B, 2, H, W)`` logits of checkpoint ``path``
-    (eval mode, CPU) and its record. ``network`` checks the record's network name."""
-    ckpt = read_checkpoint(path)
+    (eval mode, CPU) and its record. ``network`` checks the record's network name;
+    ``verify`` requires a recorded sha256 that matches (:func:`verify_checksum`)."""
+    ckpt = read_checkpoint(path, verify)
     record = ckpt[RECORD_KEY]
     if network is not None and record["network"] != network:
         raise CheckpointError(f"checkpoint {path} holds {record['network']!r}, not {network!r}")

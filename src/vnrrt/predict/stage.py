@@ -36,7 +36,7 @@ def _networks(cfg: DictConfig) -> dict:
     out = {}
     for name in cfg.predict.networks:
         ckpt = Path(cfg.paths.models) / f"{name}.ckpt"
-        net, record = load_network(ckpt, name)
+        net, record = load_network(ckpt, name, verify=True)
         out[name] = (net, record, sha256(ckpt))
     return out
 

@@ -176,9 +176,10 @@ def run_train(cfg: DictConfig, network: str) -> dict:
         if logger is not None:
             metrics["mlflow_run_id"] = logger.run_id
             log_model(cfg, network, out, logger, datamodule)
-        from vnrrt.io import sha256, write_json
+        from vnrrt.io import write_json
+        from vnrrt.model.checkpoint import write_checksum
 
-        metrics["checkpoint_sha256"] = sha256(out)
+        metrics["checkpoint_sha256"] = write_checksum(out)
         write_json(metrics_file, metrics)
         shutil.rmtree(Path(cfg.paths.models) / "checkpoints" / network, ignore_errors=True)
     return metrics
@@ -187,19 +188,19 @@ def run_train(cfg: DictConfig, network: str) -> dict:
 def log_model(cfg: DictConfig, network: str, checkpoint: Path, logger, datamodule) -> None:
     """Log the trained network to the run as an MLflow Model (pytorch flavour) with a
     signature and an input example, and register it as ``vnrrt-<network>``."""
+    from vnrrt.io import sha256
+
+    logger.experiment.set_tag(logger.run_id, "checkpoint_sha256", sha256(checkpoint))
     if not cfg.logger.log_model:
         return
     import mlflow
     import mlflow.pytorch
 
-    from vnrrt.io import sha256
     from vnrrt.model.checkpoint import load_network
 
     net, _ = load_network(checkpoint, network)
     example = datamodule.datasets["val"][0]["image"][None].numpy()  # (1, 3, S, S) float32
     mlflow.set_tracking_uri(tracking.tracking_uri(cfg.logger.uri))
-    client = logger.experiment
-    client.set_tag(logger.run_id, "checkpoint_sha256", sha256(checkpoint))
     with mlflow.start_run(run_id=logger.run_id):
         registered = cfg.logger.registry_prefix + network if cfg.logger.registry_prefix else None
         # pickle: load_model returns the nn.Module itself (any batch size; needs vnrrt installed)

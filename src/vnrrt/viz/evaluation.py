@@ -7,7 +7,7 @@ from pathlib import Path
 
 import matplotlib.pyplot as plt
 import numpy as np
-from matplotlib.ticker import LogLocator
+from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
 from vnrrt.names import STOP_NAMES, display_name, map_set_title, sort_keys
 from vnrrt.viz.common import plot_floor_map, plot_heatmap, save_figure
@@ -138,7 +138,9 @@ def convergence_figure(curves, names: dict[str, str] | None = None):
                 (line,) = ax.plot(rows["median_time"] * 1e3, rows["factor"], "o-", ms=3)
                 handles.setdefault(display_name(key), line)
             ax.set_xscale("log")
-            ax.xaxis.set_major_locator(LogLocator(base=10, numticks=4))
+            ax.xaxis.set_major_locator(LogLocator(base=10, numticks=5))
+            ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+            ax.xaxis.set_minor_formatter(NullFormatter())
             ax.set_title(map_set_title(map_set, (names or {}).get(map_set)), fontsize=9)
             ax.set_xlabel("median time (ms)", fontsize=8)
             ax.tick_params(labelsize=7)

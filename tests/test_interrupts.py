@@ -1,0 +1,65 @@
+"""Ctrl-C and SIGTERM end a running stage within seconds, leaving no process behind and no
+partial file under the output's name."""
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from tests.conftest import copy_pipeline
+from vnrrt.config import compose, dump
+
+
+def group_alive(pgid: int) -> list[int]:
+    """PIDs of live (not zombie) processes in process group ``pgid``."""
+    alive = []
+    for entry in Path("/proc").iterdir():
+        if not entry.name.isdigit():
+            continue
+        try:
+            fields = (entry / "stat").read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        if int(fields[2]) == pgid and fields[0] != "Z":
+            alive.append(int(entry.name))
+    return alive
+
+
+@pytest.mark.parametrize(
+    ("sig", "target"),
+    [(signal.SIGINT, "group"), (signal.SIGINT, "parent"), (signal.SIGTERM, "parent")],
+)
+def test_a_signal_ends_a_shard_stage_within_seconds_and_leaves_nothing(tmp_path, repo, sig,
+                                                                       target):  # fmt: skip
+    """Ctrl-C in a terminal signals the whole process group; `kill` or a scheduler signals
+    the stage's process alone, whose pool workers must then not be left running."""
+    work = copy_pipeline(repo, tmp_path)
+    cfg = compose(["scale=quick", "scale.maps_per_shard=400", "workers=2"])
+    (work / "params.yaml").write_text(dump(cfg))
+    env = dict(os.environ, PYTHONUNBUFFERED="1")
+    proc = subprocess.Popen([sys.executable, "stages/shard.py", "--shard", "0"], cwd=work,
+                            env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                            start_new_session=True)  # fmt: skip
+    time.sleep(4.0)  # the pool is up and working (400 maps take far longer)
+    assert proc.poll() is None, proc.stdout.read().decode()
+    workers = [p for p in group_alive(proc.pid) if p != proc.pid]
+    assert workers, "no pool workers started"
+    if target == "group":
+        os.killpg(proc.pid, sig)
+    else:
+        os.kill(proc.pid, sig)
+    start = time.monotonic()
+    try:
+        proc.wait(timeout=10)
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)
+        pytest.fail("the stage did not stop within 10 s")
+    assert time.monotonic() - start < 10 and proc.returncode != 0
+    time.sleep(0.5)
+    assert group_alive(proc.pid) == [], "processes survived the stage"
+    shards = work / cfg.paths.shards
+    assert not (shards / "shard_0.npz").exists() and not list(shards.glob("*.tmp-*"))
