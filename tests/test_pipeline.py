@@ -121,8 +121,13 @@ def test_smoke_dvc_repro_end_to_end(workdir):
     ):
         assert text in report, text
     ideas = (workdir / "reports/sampling_ideas.md").read_text()
-    for text in ("## Conclusion", "## Oracles, within 1% of A*", "## The heatmap-quality curve",
-                 "## The planner regime", "VNRRT* [oracle_vertex]"):
+    for text in (
+        "## Conclusion",
+        "## Oracles, within 1% of A*",
+        "## The heatmap-quality curve",
+        "## The planner regime",
+        "VNRRT* [oracle_vertex]",
+    ):
         assert text in ideas, text
     assert (workdir / "reports/figures/ideas/quality_curve.png").stat().st_size > 10_000
     headline = json.loads((workdir / "reports/metrics/headline.json").read_text())
