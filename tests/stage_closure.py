@@ -2,7 +2,8 @@
 
 Rule: start from ``stages/<stage>.py``. The module that defines the stage's entry function
 (``stage.py`` of a subpackage) counts with its module-level imports and the imports inside
-that one function (its other entry functions belong to other stages); every other module
+that function and the module's functions it calls (its other entry functions belong to other
+stages); every other module
 counts with all its imports (module level and inside functions: they run when called). Each
 imported module brings the ``__init__.py`` of its packages. ``python -m tests.stage_closure``
 prints every stage's closure as ``dvc.yaml`` deps.
@@ -42,18 +43,34 @@ def _names(node: ast.AST, here: str) -> list[str]:
     return []
 
 
+def reachable(tree: ast.Module, start: str) -> set[str]:
+    """Names of the module-level functions and classes that ``start`` calls or names,
+    transitively (``start`` included)."""
+    defs = {s.name: s for s in tree.body
+            if isinstance(s, ast.FunctionDef | ast.AsyncFunctionDef | ast.ClassDef)}  # fmt: skip
+    seen, todo = set(), [start]
+    while todo:
+        fn = todo.pop()
+        if fn in seen or fn not in defs:
+            continue
+        seen.add(fn)
+        todo += [n.id for n in ast.walk(defs[fn]) if isinstance(n, ast.Name) and n.id in defs]
+    return seen
+
+
 def imports(path: Path, name: str, only_function: str | None = None) -> set[str]:
     """vnrrt modules imported in ``path``: everywhere, or at module level plus inside
-    ``only_function``."""
+    ``only_function`` and the module's functions it calls."""
     tree = ast.parse(path.read_text())
     here = name
     nodes: list[ast.AST] = []
     if only_function is None:
         nodes = list(ast.walk(tree))
     else:
+        used = reachable(tree, only_function)
         for stmt in tree.body:
             if isinstance(stmt, ast.FunctionDef | ast.AsyncFunctionDef | ast.ClassDef):
-                if stmt.name == only_function:
+                if stmt.name in used:
                     nodes += list(ast.walk(stmt))
             else:
                 nodes += list(ast.walk(stmt))

@@ -1,12 +1,22 @@
-"""`vnrrt plan`: map formats, exit codes, printed result and figure."""
+"""The command line: map and heatmap formats, named instances, references that follow the
+endpoints, exit codes, one-line errors without tracebacks, the figure, --version and
+``python -m vnrrt``."""
+
+import subprocess
+import sys
 
 import cv2
 import numpy as np
 import pytest
+from omegaconf import OmegaConf
 
 from vnrrt.cli import main
+from vnrrt.config import CONF_DIR, section
+from vnrrt.data.build import build_shard
+from vnrrt.data.build_named import build_named_maps
 from vnrrt.data.config import LabelsConfig
 from vnrrt.maps.config import DataConfig
+from vnrrt.planners import PlannerConfig
 
 
 @pytest.fixture
@@ -19,12 +29,26 @@ def map_npy(tmp_path):
     return path
 
 
+@pytest.fixture(scope="module")
+def named(tmp_path_factory):
+    path = tmp_path_factory.mktemp("named") / "named_maps.npz"
+    build_named_maps(path, 200, LabelsConfig())
+    return path
+
+
+def test_the_package_defaults_equal_conf_planner_default():
+    """The CLI needs no conf/ at run time: its defaults are PlannerConfig's, kept equal."""
+    conf = section({"planner": OmegaConf.load(CONF_DIR / "planner/default.yaml")}, "planner",
+                   PlannerConfig)  # fmt: skip
+    assert conf == PlannerConfig()
+
+
 def test_plan_npy_optimal_writes_figure(map_npy, tmp_path, capsys):
     out = tmp_path / "plan.png"
     rc = main(["plan", "--map", str(map_npy), "--start", "8.5,8.5", "--goal", "72.5,8.5",
                "--stop", "optimal", "--set", "eta=8", "--out", str(out)])  # fmt: skip
     text = capsys.readouterr().out
-    assert rc == 0 and "success=True" in text and "any-angle" in text
+    assert rc == 0 and "success=True" in text and "exact" in text
     assert out.stat().st_size > 5_000
 
 
@@ -40,14 +64,28 @@ def test_plan_class_png_with_heatmap(tmp_path, capsys):
 
 
 def test_plan_shard_instance(tmp_path, capsys):
-    from vnrrt.data.build import build_shard
-
     data = DataConfig(size=64, n_obstacles=[2, 4], obstacle_size=[6.0, 12.0], bar_width=[2.0, 3.0],
                       n_starts=2, n_goals=2, min_start_goal_distance=10.0)  # fmt: skip
     shard = tmp_path / "shard_0.npz"
     build_shard(shard, 0, seed=1, maps_per_shard=1, data=data, labels=LabelsConfig(), workers=1)
     rc = main(["plan", "--map", str(shard), "--instance", "3", "--stop", "optimal"])
     assert rc == 0 and "cost/A*" in capsys.readouterr().out
+
+
+def test_named_maps_by_name_and_a_moved_start_gets_its_own_reference(named, capsys):
+    assert main(["plan", "--map", str(named), "--instance", "u_trap"]) == 0
+    assert "success=True" in capsys.readouterr().out
+    rc = main(["plan", "--map", str(named), "--instance", "2", "--start", "130.5,170.5",
+               "--stop", "optimal", "--set", "max_seconds=20"])  # fmt: skip
+    text = capsys.readouterr().out
+    ratio = float(text.split("cost/A* ")[1].split()[0])
+    assert rc == 0 and ratio <= 1.01  # not the stored instance's 344.99 px
+    assert "ref=344.99" not in text
+
+
+def test_start_equal_to_goal_is_a_zero_length_plan(map_npy, capsys):
+    rc = main(["plan", "--map", str(map_npy), "--start", "8.5,8.5", "--goal", "8.5,8.5"])
+    assert rc == 0 and "n/a" in capsys.readouterr().out
 
 
 @pytest.mark.parametrize(
@@ -57,13 +95,49 @@ def test_plan_shard_instance(tmp_path, capsys):
         (["--start", "8.5,8.5", "--goal", "72.5,8.5", "--planner", "vnrrt_star"], "heatmap"),
         (["--start", "8.5,8.5", "--goal", "72.5,8.5", "--set", "etta=3"], "unknown"),
         (["--goal", "72.5,8.5"], "--start"),
+        (["--start", "8.5,8.5", "--goal", "72.5,8.5", "--set", "max_iterations=1e12"],
+         "max_iterations"),
+        (["--start", "8.5,8.5", "--goal", "72.5,8.5", "--planner", "m_vnrrt_star", "--tau",
+          "1.5"], "--tau"),
+        (["--start", "8.5,8.5", "--goal", "72.5,8.5", "--out", "{tmp}"], "directory"),
+        (["--start", "8.5,8.5", "--goal", "72.5,8.5", "--config", "{tmp}/broken.yaml"],
+         "not valid YAML"),
+        (["--instance", "3"], "--instance"),
     ],
-)
-def test_bad_input_exit_code_2(map_npy, capsys, extra, message):
-    assert main(["plan", "--map", str(map_npy), *extra]) == 2
-    assert message in capsys.readouterr().err
+)  # fmt: skip
+def test_bad_input_is_one_line_and_exit_code_2(map_npy, tmp_path, capsys, extra, message):
+    (tmp_path / "broken.yaml").write_text("eta: [1, 2\n")
+    args = [a.format(tmp=tmp_path) for a in extra]
+    assert main(["plan", "--map", str(map_npy), *args]) == 2
+    err = capsys.readouterr().err
+    assert message in err and err.count("\n") == 1 and "Traceback" not in err
+
+
+def test_an_all_black_png_is_a_grayscale_map_of_obstacles(tmp_path, capsys):
+    """Rule: a PNG is a class map only when it holds a start (2) and a goal (3) pixel; an
+    all-black image is a grayscale map whose dark pixels are obstacles, not a free map."""
+    cv2.imwrite(str(tmp_path / "black.png"), np.zeros((40, 40), np.uint8))
+    rc = main(["plan", "--map", str(tmp_path / "black.png"), "--start", "5.5,5.5",
+               "--goal", "30.5,30.5"])  # fmt: skip
+    assert rc == 2 and "obstacle" in capsys.readouterr().err
+
+
+def test_a_huge_budget_allocates_as_it_goes(map_npy):
+    """The tree grows with the work: a budget of 10^12 iterations is no 14 TiB allocation."""
+    rc = main(["plan", "--map", str(map_npy), "--start", "8.5,8.5", "--goal", "72.5,8.5",
+               "--stop", "optimal", "--set", "max_iterations=1000000000000"])  # fmt: skip
+    assert rc == 0
 
 
 def test_budget_hit_exit_code_1(map_npy):
     args = ["--start", "8.5,8.5", "--goal", "72.5,8.5", "--set", "max_iterations=5"]
     assert main(["plan", "--map", str(map_npy), *args]) == 1
+
+
+def test_version_and_module_entry_point_with_plain_help():
+    out = subprocess.run([sys.executable, "-m", "vnrrt", "--version"], capture_output=True,
+                         text=True, check=True).stdout  # fmt: skip
+    assert out.startswith("vnrrt 0.")
+    help_text = subprocess.run([sys.executable, "-m", "vnrrt", "--help"], capture_output=True,
+                               text=True, check=True).stdout  # fmt: skip
+    assert "vnrrt plan" in help_text and "``" not in help_text and ":func:" not in help_text

@@ -174,3 +174,10 @@ def test_a_perfect_path_heatmap_makes_nrrt_reach_the_optimum_in_far_fewer_iterat
     med = table.groupby("key")["iterations"].median()
     assert med["nrrt_star"] < 0.5 * med["rrt_star"], med.to_dict()
     assert table.loc[table["key"] == "nrrt_star", "heat_mass"].min() > 0.9
+
+
+def test_taut_oracles_are_measured_against_the_exact_path(turning):
+    heat = instance_heatmap("oracle_taut_vertex", turning)
+    assert mass_near(heat, target_mask(turning, "taut_vertices"), 3.0) > 0.9
+    heat = instance_heatmap("oracle_taut_path", turning)
+    assert mass_near(heat, target_mask(turning, "taut_path"), 3.0) > 0.9

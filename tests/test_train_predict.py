@@ -112,3 +112,29 @@ def test_bad_parts_and_missing_heatmaps_are_named(predicted, tmp_path):
     (tmp_path / "bad.npz").write_bytes(b"not a zip")
     with pytest.raises(HeatmapError, match="bad.npz is not a readable"):
         read_heatmaps(tmp_path / "bad.npz")
+
+
+def test_the_command_line_predicts_what_the_stage_predicted(predicted, tmp_path, capsys):
+    """`vnrrt predict` and `vnrrt plan --checkpoint` on a named map give the pipeline's
+    heatmap for that instance (row 2 of the parts: named map 3)."""
+    from vnrrt.cli import main
+
+    cfg, _, _ = predicted
+    ckpt = str(Path(cfg.paths.models) / "vertexnet.ckpt")
+    out = tmp_path / "heat.npy"
+    named = str(cfg.paths.named_maps)
+    assert main(["predict", "--checkpoint", ckpt, "--map", named, "--instance",
+                 "narrow_passage", "--out", str(out)]) == 0  # fmt: skip
+    want = read_parts(cfg.paths.heatmaps, [0, 1, 2])["maps"]["vertexnet"][2].astype(np.float32)
+    np.testing.assert_allclose(np.load(out), want, atol=1e-3)
+    png = tmp_path / "heat.png"
+    assert main(["predict", "--checkpoint", ckpt, "--map", named, "--instance", "2",
+                 "--out", str(png)]) == 0  # fmt: skip
+    assert png.read_bytes()[:4] == b"\x89PNG"
+    rc = main(["plan", "--map", named, "--instance", "2", "--planner", "vnrrt_star",
+               "--checkpoint", ckpt])  # fmt: skip
+    assert rc == 0 and "vnrrt_star: success=True" in capsys.readouterr().out
+    heat_file = part_file(cfg.paths.heatmaps, 0)
+    rc = main(["plan", "--map", named, "--instance", "2", "--planner", "vnrrt_star",
+               "--heatmap", str(heat_file), "--network", "vertexnet"])  # fmt: skip
+    assert rc == 0

@@ -47,8 +47,8 @@ TARGET = {
     "oracle_vertex": "interior_vertices",
     "oracle_vertex_endpoints": "vertices",
     "oracle_endpoints": "endpoints",
-    "oracle_taut_path": "path",
-    "oracle_taut_vertex": "interior_vertices",
+    "oracle_taut_path": "taut_path",
+    "oracle_taut_vertex": "taut_vertices",
 }
 
 
@@ -180,8 +180,14 @@ def instance_heatmap(source: str, inst, sigma: float = 1.0, floor: float = 0.0) 
 
 def target_mask(inst, target: str) -> np.ndarray:
     """``(H, W)`` bool cells of an instance's ``target``: ``'path'`` (the A* path),
-    ``'vertices'`` (its vertices), ``'interior_vertices'`` (without start and goal) or
-    ``'endpoints'`` (start and goal)."""
+    ``'vertices'`` (its vertices), ``'interior_vertices'`` (without start and goal),
+    ``'endpoints'`` (start and goal), ``'taut_path'`` (the cells the exact optimum crosses)
+    or ``'taut_vertices'`` (the four pixels around each of its interior turning points)."""
+    if target in ("taut_path", "taut_vertices"):
+        img = np.zeros(inst.grid.shape)
+        pts = np.asarray(inst.exact_path, np.float64)
+        _splat(img, _polyline_points(pts) if target == "taut_path" else pts[1:-1])
+        return img > 0
     cells = {
         "path": inst.path,
         "vertices": inst.vertices,

@@ -30,6 +30,7 @@ from vnrrt.planners.samplers import Sampler, heatmap_sampler, rng_state, uniform
 log = logging.getLogger(__name__)
 
 FIRST_CHUNK, MAX_CHUNK = 64, 4096  # iterations per compiled call; budgets checked between
+FIRST_CAPACITY = 4096  # tree nodes allocated first; doubled when full (up to the budget)
 
 
 def make_sampler(
@@ -177,7 +178,8 @@ def _timed(occ, start, goal, planner, sampler, target, milestones, seed, cfg, ke
     """The timed part of :func:`plan` on validated inputs; ``target`` None = first solution."""
     bounds = tuple(float(m) for m in milestones)
     t0 = time.perf_counter()
-    tree = core.Tree(cfg.max_iterations + 2, occ.shape, max(cfg.eta / 2, 1.0), cfg.trace_capacity)
+    capacity = min(cfg.max_iterations + 2, FIRST_CAPACITY)
+    tree = core.Tree(capacity, occ.shape, max(cfg.eta / 2, 1.0), cfg.trace_capacity)
     wanted = {math.inf, *bounds, *([] if target is None else [target])}
     stops = np.array(sorted(wanted, reverse=True))
     reason, times, iters = _drive(tree, occ, sampler, start, goal, stops, target, seed, cfg, t0)
@@ -216,7 +218,10 @@ def _drive(tree, occ, sampler, start, goal, stops, target, seed, cfg, t0):
         if c[core.GOAL] >= 0 and tree.cost[c[core.GOAL]] <= stop_bound:
             return "solved", times, iters
         if status == core.TREE_FULL:
-            return "tree_full", times, iters
+            if tree.capacity >= cfg.max_iterations + 2:
+                return "tree_full", times, iters
+            tree.grow(min(2 * tree.capacity, cfg.max_iterations + 2))
+            status = core.RUNNING
         if c[core.ITERS] >= cfg.max_iterations:
             return "max_iterations", times, iters
         if now >= cfg.max_seconds:

@@ -77,8 +77,10 @@ class PlannerConfig:
         self._check("eps", _finite(self.eps) and self.eps >= 0, ">= 0")
         ok = _finite(self.min_spacing) and 0 <= self.min_spacing < self.eta
         self._check("min_spacing", ok, ">= 0 and < eta")
-        self._check("max_iterations", self.max_iterations >= 1, ">= 1")
-        self._check("trace_capacity", self.trace_capacity >= 2, ">= 2")
+        ok = _integer(self.max_iterations) and self.max_iterations >= 1
+        self._check("max_iterations", ok, "an integer >= 1")
+        ok = _integer(self.trace_capacity) and self.trace_capacity >= 2
+        self._check("trace_capacity", ok, "an integer >= 2")
         self._check("tau", _finite(self.tau), "finite")
         self._check("taus", all(_finite(t) for t in self.taus), "finite values")
 
@@ -98,6 +100,10 @@ class PlannerConfig:
         new = dataclasses.replace(self, **changes)
         new.validate()
         return new
+
+
+def _integer(v) -> bool:
+    return isinstance(v, int) and not isinstance(v, bool)
 
 
 def _finite(v) -> bool:

@@ -58,6 +58,27 @@ class Tree:
         self.near_ok = np.empty(c, np.int8)
         self.stack = np.empty(c, np.int64)
 
+    def grow(self, capacity: int) -> None:
+        """Enlarge the arrays to ``capacity`` nodes, keeping the tree (memory grows with the
+        work done, not with the iteration budget)."""
+        c, n = int(capacity), len(self.cost)
+        if c <= n:
+            return
+        for name in ("pts", "cost", "links", "bnext"):
+            old = getattr(self, name)
+            new = np.empty((c, *old.shape[1:]), old.dtype)
+            new[:n] = old
+            setattr(self, name, new)
+        self.near_idx = np.empty(c, np.int64)
+        self.near_d = np.empty(c)
+        self.near_c = np.empty(c)
+        self.near_ok = np.empty(c, np.int8)
+        self.stack = np.empty(c, np.int64)
+
+    @property
+    def capacity(self) -> int:
+        return len(self.cost)
+
     def add_root(self, x: float, y: float) -> None:
         """Insert the start node (index 0, cost 0)."""
         add_node(self.pts, self.cost, self.links, 0, -1, x, y, 0.0)

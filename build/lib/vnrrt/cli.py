@@ -1,0 +1,335 @@
+"""The vnrrt command line: plan with RRT*, NRRT*, VNRRT* or M-VNRRT*, and predict heatmaps
+with a trained network.
+
+  vnrrt plan --map FILE [--instance NAME|I] [--start X,Y --goal X,Y] [--planner P]
+             [--heatmap FILE | --checkpoint CKPT] [--tau T] [--stop initial|optimal]
+             [--set KEY=VALUE ...] [--out plan.png]
+  vnrrt predict --checkpoint CKPT --map FILE [--instance NAME|I | --start X,Y --goal X,Y]
+             --out heatmap.npy|heatmap.png
+
+Maps: .npy occupancy (H, W), nonzero = obstacle; .png floor map: a class map (values 0 free,
+1 obstacle, 2 start, 3 goal, with at least one start and one goal pixel), otherwise a
+grayscale image whose dark pixels (< 128) are obstacles; .npz: a dataset shard or the
+pipeline's named maps (with --instance, an index or a named map's name, e.g. u_trap).
+Points are continuous (x, y) pixels; the cells of class maps and shards give their centres.
+Heatmaps: .npy (H, W), a grayscale .png scaled to [0, 1], or a pipeline heatmap file (.npz,
+with --instance and --network). Exit status: 0 success, 1 the planner stopped on a budget,
+2 bad input (one line on stderr, no traceback).
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+from vnrrt import __version__
+
+
+class UsageError(ValueError):
+    """A command-line argument is wrong; the message names it."""
+
+
+def _point(text: str) -> tuple[float, float]:
+    try:
+        x, y = (float(v) for v in text.split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected X,Y (two numbers), got {text!r}") from None
+    if not (math.isfinite(x) and math.isfinite(y)):
+        raise argparse.ArgumentTypeError(f"expected finite X,Y, got {text!r}")
+    return x, y
+
+
+def _read_image(path: Path) -> np.ndarray:
+    import cv2
+
+    img = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
+    if img is None:
+        raise UsageError(f"cannot read image {path}")
+    return img if img.ndim == 2 else cv2.cvtColor(img[..., :3], cv2.COLOR_BGR2GRAY)
+
+
+def _first_pixel(img: np.ndarray, value: int):
+    ys, xs = np.nonzero(img == value)
+    return (float(xs[0]) + 0.5, float(ys[0]) + 0.5) if len(xs) else None
+
+
+def _shard_instance(path: Path, instance: str | None) -> dict:
+    from vnrrt.data.reader import Shard
+
+    if instance is None:
+        raise UsageError(f"{path} holds many instances: give --instance (an index or a name)")
+    shard = Shard(path)
+    _verify_against_manifest(path)
+    names = list(shard.meta.get("names", []))
+    if instance in names:
+        index = names.index(instance)
+    elif instance.lstrip("-").isdigit():
+        index = int(instance)
+    else:
+        known = f"; names: {', '.join(names)}" if names else ""
+        raise UsageError(f"--instance {instance!r} is not an index of {path}{known}")
+    if not 0 <= index < shard.n_instances:
+        raise UsageError(f"--instance {index} not in [0, {shard.n_instances}) of {path}")
+    inst = shard.instance(index)
+    s, g = inst["start"], inst["goal"]
+    return {"grid": shard.grid(inst["map_index"]), "start": (s[0] + 0.5, s[1] + 0.5),
+            "goal": (g[0] + 0.5, g[1] + 0.5), "astar": inst["length"], "index": index}  # fmt: skip
+
+
+def _verify_against_manifest(path: Path) -> None:
+    """A shard beside a pipeline manifest (``../manifest.json``) must match its checksum."""
+    from vnrrt.data.manifest import verify_manifest
+
+    manifest = path.parent.parent / "manifest.json"
+    if manifest.is_file() and path.parent.name == "shards":
+        listed = {p.resolve() for p in verify_manifest(manifest)}
+        if path.resolve() not in listed:
+            raise UsageError(f"{path} is not listed in {manifest}")
+
+
+def load_instance(path: Path, instance: str | None) -> dict:
+    """Grid ``(H, W)`` uint8 and, where the file holds them, start/goal points and the A*
+    length (formats in the module doc)."""
+    if not path.is_file():
+        raise UsageError(f"map file {path} not found")
+    if path.suffix == ".npz":
+        return _shard_instance(path, instance)
+    if instance is not None:
+        raise UsageError(f"--instance needs a shard or named-maps .npz, not {path.suffix}")
+    if path.suffix == ".npy":
+        return {"grid": np.load(path)}
+    if path.suffix == ".png":
+        img = _read_image(path)
+        start, goal = _first_pixel(img, 2), _first_pixel(img, 3)
+        if img.max() <= 3 and start is not None and goal is not None:
+            return {"grid": (img == 1).astype(np.uint8), "start": start, "goal": goal}
+        return {"grid": (img < 128).astype(np.uint8)}
+    raise UsageError(f"unsupported map file {path}: use .npy, .png or a shard .npz")
+
+
+def load_heatmap(path: Path, instance: int | None = None, network: str | None = None) -> np.ndarray:
+    """Heatmap ``(H, W)`` float64 from ``.npy``, a grayscale ``.png`` (scaled to [0, 1]) or a
+    pipeline heatmap file (``.npz``: row ``instance`` of ``network``)."""
+    if not path.is_file():
+        raise UsageError(f"heatmap file {path} not found")
+    if path.suffix == ".npy":
+        return np.load(path).astype(np.float64)
+    if path.suffix == ".png":
+        img = _read_image(path)
+        return img.astype(np.float64) / float(np.iinfo(img.dtype).max)
+    if path.suffix == ".npz":
+        from vnrrt.data.heatmaps import read_heatmaps
+
+        heat = read_heatmaps(path)
+        nets = sorted(heat["maps"])
+        if network not in heat["maps"]:
+            raise UsageError(f"give --network, one of {nets} in {path}")
+        if instance is None or not 0 <= instance < len(heat["keys"]):
+            raise UsageError(f"--instance must index the {len(heat['keys'])} rows of {path}")
+        return heat["maps"][network][instance].astype(np.float64)
+    raise UsageError(f"unsupported heatmap file {path}: use .npy, .png or a pipeline .npz")
+
+
+def _overrides(pairs: list[str]) -> dict:
+    """``key=value`` strings parsed as YAML scalars (``eta=5`` gives 5, ``gamma=null``)."""
+    import yaml
+
+    out = {}
+    for pair in pairs:
+        key, sep, value = pair.partition("=")
+        if not sep or not key:
+            raise UsageError(f"--set expects key=value, got {pair!r}")
+        try:
+            out[key.strip()] = yaml.safe_load(value)
+        except yaml.YAMLError:
+            raise UsageError(f"--set {pair!r}: the value is not a number or word") from None
+    return out
+
+
+def _planner_config(path: Path | None, pairs: list[str]):
+    """``PlannerConfig`` defaults (identical to ``conf/planner/default.yaml``, tested), or a
+    planner YAML, with ``--set`` overrides."""
+    from vnrrt.planners import PlannerConfig
+
+    cfg = PlannerConfig()
+    if path is not None:
+        import yaml
+        from omegaconf import OmegaConf
+
+        from vnrrt.config import section
+
+        if not path.is_file():
+            raise UsageError(f"--config {path} not found")
+        try:
+            node = OmegaConf.create(yaml.safe_load(path.read_text()) or {})
+        except yaml.YAMLError as err:
+            first = str(err).splitlines()[0]
+            raise UsageError(f"--config {path} is not valid YAML: {first}") from None
+        cfg = section({"planner": node}, "planner", PlannerConfig)
+    return cfg.replace(**_overrides(pairs))
+
+
+def _endpoints(args, inst: dict) -> tuple[tuple, tuple]:
+    start = args.start or inst.get("start")
+    goal = args.goal or inst.get("goal")
+    if start is None or goal is None:
+        raise UsageError("give --start X,Y and --goal X,Y (the map file does not hold them)")
+    return start, goal
+
+
+def _reference(inst: dict, start, goal, cfg):
+    """The stored A* length when start and goal are the instance's own; else None, so that
+    the planner computes the reference for these endpoints."""
+    same = inst.get("start") == tuple(start) and inst.get("goal") == tuple(goal)
+    return inst.get("astar") if same and cfg.reference == "astar" else None
+
+
+def add_plan_command(sub: argparse._SubParsersAction) -> None:
+    """Register ``vnrrt plan``."""
+    from vnrrt.planners import PLANNERS
+
+    p = sub.add_parser(
+        "plan",
+        help="run one planner on one instance and draw it",
+        description="Run one planner on one instance (see `vnrrt --help`).",
+    )
+    p.add_argument("--map", type=Path, required=True, help=".npy, .png or shard/named-maps .npz")
+    p.add_argument("--instance", help="instance index or named map (u_trap) of an .npz")
+    p.add_argument("--start", type=_point, help="start point X,Y in pixels")
+    p.add_argument("--goal", type=_point, help="goal point X,Y in pixels")
+    p.add_argument("--planner", choices=PLANNERS, default="rrt_star")
+    p.add_argument("--heatmap", type=Path, help="sampling heatmap .npy, .png or pipeline .npz")
+    p.add_argument("--network", help="network of a pipeline heatmap .npz (vertexnet, nrrtnet)")
+    p.add_argument("--row", type=int, help="row of a pipeline heatmap .npz (default: --instance)")
+    p.add_argument("--checkpoint", help="predict the heatmap with this network checkpoint")
+    p.add_argument("--tau", type=float, help="mask threshold of m_vnrrt_star, in (0, 1]")
+    p.add_argument("--stop", choices=("initial", "optimal"), default="initial")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--config", type=Path, help="planner YAML (default: the package defaults)")
+    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                   help="override a planner setting, e.g. --set eta=5 (repeatable)")  # fmt: skip
+    p.add_argument("--out", type=Path, help="write a PNG of map, heatmap, tree and path")
+    p.set_defaults(func=run_plan)
+
+
+def _heatmap(args, inst: dict, start, goal) -> np.ndarray | None:
+    if args.heatmap and args.checkpoint:
+        raise UsageError("give --heatmap or --checkpoint, not both")
+    if args.checkpoint:
+        from vnrrt.grid import point_to_cell
+        from vnrrt.predict import heatmap
+
+        cells = point_to_cell(np.array([start, goal]))
+        return heatmap(args.checkpoint, inst["grid"], tuple(cells[0]), tuple(cells[1]))
+    if args.heatmap:
+        row = args.row if args.row is not None else inst.get("index")
+        return load_heatmap(args.heatmap, row, args.network)
+    return None
+
+
+def run_plan(args: argparse.Namespace) -> int:
+    """``vnrrt plan``: print the result and both reference lengths; 0 on success."""
+    from vnrrt.planners import any_angle_length, astar_length, plan
+
+    if args.tau is not None and not 0.0 < args.tau <= 1.0:
+        raise UsageError(f"--tau {args.tau}: must be in (0, 1] (heatmaps are probabilities)")
+    cfg = _planner_config(args.config, args.set)
+    inst = load_instance(args.map, args.instance)
+    start, goal = _endpoints(args, inst)
+    heatmap = _heatmap(args, inst, start, goal)
+    if args.out is not None and args.out.is_dir():
+        raise UsageError(f"--out {args.out} is a directory; give a .png file name")
+    result = plan(inst["grid"], start, goal, args.planner, heatmap=heatmap, tau=args.tau,
+                  stop=args.stop, reference_length=_reference(inst, start, goal, cfg),
+                  seed=args.seed, config=cfg, keep_tree=args.out is not None)  # fmt: skip
+    print(result.summary())
+    try:
+        a, t = astar_length(inst["grid"], start, goal), any_angle_length(inst["grid"], start, goal)
+        ratio = f"{result.cost / a:.4f}" if a > 0 else "n/a (start and goal coincide)"
+        print(f"reference lengths: A* {a:.2f} px, exact {t:.2f} px; cost/A* {ratio}")
+    except ValueError as err:  # start and goal not connected
+        print(f"reference lengths: none ({err})")
+    print(f"path: {len(result.path)} points; fallback_uniform={result.fallback_uniform}")
+    if args.out:
+        from vnrrt.viz.planners import save_plan
+
+        save_plan(args.out, inst["grid"], result, start, goal, heatmap)
+        print(f"figure: {args.out}")
+    return 0 if result.success else 1
+
+
+def add_predict_command(sub: argparse._SubParsersAction) -> None:
+    """Register ``vnrrt predict``."""
+    p = sub.add_parser("predict", help="a trained network's heatmap for one instance",
+                       description="Predict a heatmap (see `vnrrt --help`).")  # fmt: skip
+    p.add_argument("--checkpoint", required=True, help="checkpoint .ckpt or MLflow model URI")
+    p.add_argument("--map", type=Path, required=True, help=".npy, .png or shard/named-maps .npz")
+    p.add_argument("--instance", help="instance index or named map (u_trap) of an .npz")
+    p.add_argument("--start", type=_point, help="start point X,Y in pixels")
+    p.add_argument("--goal", type=_point, help="goal point X,Y in pixels")
+    p.add_argument("--device", default="cpu", help="torch device (default cpu)")
+    p.add_argument("--out", type=Path, required=True, help="heatmap .npy (float32) or .png")
+    p.set_defaults(func=run_predict)
+
+
+def run_predict(args: argparse.Namespace) -> int:
+    """``vnrrt predict``: write the heatmap; 0 on success."""
+    from vnrrt.grid import point_to_cell
+    from vnrrt.predict import heatmap
+
+    inst = load_instance(args.map, args.instance)
+    start, goal = _endpoints(args, inst)
+    if args.out.suffix not in (".npy", ".png") or args.out.is_dir():
+        raise UsageError(f"--out {args.out}: give a .npy or .png file name")
+    cells = point_to_cell(np.array([start, goal]))
+    heat = heatmap(args.checkpoint, inst["grid"], tuple(cells[0]), tuple(cells[1]), args.device)
+    from vnrrt.io import atomic_write_bytes
+
+    if args.out.suffix == ".npy":
+        atomic_write_bytes(args.out, lambda f: np.save(f, heat))
+    else:
+        import cv2
+
+        _, png = cv2.imencode(".png", np.round(heat * 65535).astype(np.uint16))
+        atomic_write_bytes(args.out, lambda f: f.write(png.tobytes()))
+    print(f"heatmap {heat.shape[1]}x{heat.shape[0]}, max {heat.max():.3f}: {args.out}")
+    return 0
+
+
+COMMANDS: list[Callable[[argparse._SubParsersAction], None]] = [
+    add_plan_command,
+    add_predict_command,
+]
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The ``vnrrt`` parser with one sub-command per entry of :data:`COMMANDS`."""
+    parser = argparse.ArgumentParser(
+        prog="vnrrt", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
+    parser.add_argument("--version", action="version", version=f"vnrrt {__version__}")
+    sub = parser.add_subparsers(dest="command", required=True)
+    for add in COMMANDS:
+        add(sub)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the ``vnrrt`` console script and ``python -m vnrrt``; returns the exit
+    status (module doc)."""
+    args = build_parser().parse_args(argv)
+    try:
+        return args.func(args)
+    except (ValueError, FileNotFoundError, IsADirectoryError, PermissionError) as err:
+        message = str(err).splitlines()[0] if str(err) else type(err).__name__
+        print(f"vnrrt {args.command}: error: {message}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,154 @@
+"""Configuration: Hydra composition of ``conf/`` and typed, validated sections.
+
+``conf/`` is the single source of truth. DVC composes it into ``params.yaml`` on
+``dvc exp run`` (``hydra.enabled``); :func:`compose` does the same composition here (used
+by ``make params`` and by the test that keeps the committed ``params.yaml`` in sync).
+Stages read ``params.yaml`` with :func:`load_params`, see only the keys their ``dvc.yaml``
+entry declares (:func:`restrict`) and validate the sections they use against typed
+dataclasses (:func:`section`), so an unknown key or a wrong type fails with a message that
+names the key. :mod:`vnrrt.validate` checks the whole composition before any stage runs.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+from pathlib import Path
+from typing import Any, TypeVar
+
+from omegaconf import DictConfig, OmegaConf
+from omegaconf.errors import OmegaConfBaseException
+
+REPO_ROOT = Path(__file__).resolve().parents[2]
+CONF_DIR = Path(os.environ.get("VNRRT_CONF_DIR", REPO_ROOT / "conf"))
+
+T = TypeVar("T")
+
+
+class ConfigError(ValueError):
+    """A configuration value or key is invalid; the message names it."""
+
+
+def check_parts(parts, key: str) -> list[int]:
+    """``parts`` (the ids of a stage's parts, e.g. ``eval.parts``) as a list of ints;
+    :class:`ConfigError` naming ``key`` unless it is ``[0, 1, ..., K-1]`` with K >= 1."""
+    try:
+        ids = None if isinstance(parts, str) else [int(p) for p in parts]
+    except (TypeError, ValueError):
+        ids = None
+    check(bool(ids) and ids == list(range(len(ids))), key, parts, "must be [0, 1, ..., K-1]")
+    return ids
+
+
+def check(ok: bool, key: str, value: Any, why: str) -> None:
+    """Raise :class:`ConfigError` ``invalid config value key=value: why`` unless ``ok``."""
+    if not ok:
+        raise ConfigError(f"invalid config value {key}={value!r}: {why}")
+
+
+def section(cfg: DictConfig | dict, key: str, schema: type[T]) -> T:
+    """Return ``cfg[key]`` as a validated ``schema`` instance.
+
+    Unknown or missing keys, missing sections and wrong types raise :class:`ConfigError`
+    naming the offending ``key.subkey`` (defaults of the dataclasses serve library callers;
+    a composed config must give every key).
+    """
+    node = cfg.get(key) if isinstance(cfg, DictConfig | dict) else None
+    if node is None:
+        raise ConfigError(f"config section {key!r} is missing")
+    names = [f.name for f in dataclasses.fields(schema)]
+    unknown = [str(k) for k in node if k not in names]
+    if unknown:
+        raise ConfigError(
+            f"unknown config key(s) {[f'{key}.{k}' for k in unknown]}; known: {names}"
+        )
+    missing = [n for n in names if n not in node]
+    if missing:
+        raise ConfigError(f"config section {key!r} lacks {missing} (conf/ gives every key)")
+    try:
+        merged = OmegaConf.merge(OmegaConf.structured(schema), node)
+        obj = OmegaConf.to_object(merged)
+    except OmegaConfBaseException as err:
+        where = f"{key}.{err.full_key}" if getattr(err, "full_key", None) else key
+        raise ConfigError(f"bad config at {where!r}: {err.msg}") from None
+    try:
+        obj.validate()
+    except ConfigError:
+        raise
+    except ValueError as err:  # a library's own settings error (e.g. PlannerConfigError)
+        raise ConfigError(f"{key}: {err}") from None
+    return obj
+
+
+def load_params(path: str | Path = "params.yaml") -> DictConfig:
+    """Load the composed parameters file (``params.yaml``) written by DVC or ``make params``."""
+    path = Path(path)
+    if not path.is_file():
+        raise ConfigError(f"parameters file {path} not found (run `make params`)")
+    try:
+        cfg = OmegaConf.load(path)
+    except Exception as err:  # YAML errors of several kinds
+        raise ConfigError(f"parameters file {path} is not valid YAML: {err}") from None
+    if not isinstance(cfg, DictConfig) or not cfg:
+        raise ConfigError(f"parameters file {path} is empty or not a mapping (run `make params`)")
+    return cfg
+
+
+# Sections every stage receives without listing them as DVC params: where files go
+# (DVC tracks them as deps and outs), where runs are logged and how many processes to use
+# (neither changes an output).
+ALWAYS = ("paths", "logger", "workers")
+
+
+def restrict(cfg: DictConfig, keys: list[str], always: tuple[str, ...] = ALWAYS) -> DictConfig:
+    """A copy of ``cfg`` holding only the dotted ``keys`` (and ``always``); reading any other
+    key fails, so a stage can only use the parameters its ``dvc.yaml`` entry declares."""
+    out = OmegaConf.create({})
+    for key in [*always, *keys]:
+        value = OmegaConf.select(cfg, key, default=_MISSING)
+        if value is _MISSING:
+            raise ConfigError(f"parameter {key!r} is declared but missing from the parameters")
+        OmegaConf.update(out, key, value, merge=False, force_add=True)
+    OmegaConf.set_struct(out, True)
+    return out
+
+
+_MISSING = object()
+
+
+def stage_params(stage: str, dvc_yaml: str | Path = "dvc.yaml") -> list[str]:
+    """The dotted ``params`` keys of stage ``stage`` (``name`` or ``name@item``; ``${item}``
+    in a key becomes ``item``) in ``dvc_yaml``; :class:`ConfigError` if it is not there."""
+    import yaml
+
+    path = Path(dvc_yaml)
+    if not path.is_file():
+        raise ConfigError(f"{path} not found: run stages from the repository root")
+    stages = (yaml.safe_load(path.read_text()) or {}).get("stages", {})
+    name, _, item = stage.partition("@")
+    if name not in stages:
+        raise ConfigError(f"stage {name!r} is not in {path}")
+    entry = stages[name].get("do", stages[name])
+    keys = [k for k in entry.get("params", []) if isinstance(k, str)]
+    return [k.replace("${item}", item) for k in keys]
+
+
+def compose(overrides: list[str] | tuple[str, ...] = ()) -> DictConfig:
+    """Compose ``conf/config.yaml`` with Hydra overrides and resolve it, exactly as DVC does."""
+    from hydra import compose as hydra_compose
+    from hydra import initialize_config_dir
+
+    with initialize_config_dir(str(CONF_DIR), version_base=None):
+        cfg = hydra_compose(config_name="config", overrides=list(overrides))
+    OmegaConf.resolve(cfg)
+    return cfg
+
+
+def dump(cfg: DictConfig) -> str:
+    """YAML text of a composed config, in the format DVC writes ``params.yaml``."""
+    return OmegaConf.to_yaml(cfg)
+
+
+def asdict(obj: Any) -> dict:
+    """Plain dict of a config dataclass (for hashing and metadata)."""
+    return dataclasses.asdict(obj)

@@ -1,0 +1,1 @@
+"""Sharded datasets: the shard format, building shards, reading them, the manifest."""

@@ -1,0 +1,37 @@
+"""The ``labels`` and ``scale`` config sections: typed mirrors of ``conf/labels`` and
+``conf/scale``."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from vnrrt.config import check
+
+
+@dataclass
+class LabelsConfig:
+    """Vertex labelling (paper, Method/Ground Truth)."""
+
+    vertex_steps: list[int] = field(default_factory=lambda: [1, 2, 3])
+
+    def validate(self) -> None:
+        ok = bool(self.vertex_steps) and all(k >= 1 for k in self.vertex_steps)
+        check(ok, "labels.vertex_steps", self.vertex_steps, "must be positive step sizes")
+
+
+@dataclass
+class ScaleConfig:
+    """How much data: ``len(shards) * maps_per_shard`` maps, 144 instances each by default."""
+
+    name: str = "quick"
+    maps_per_shard: int = 50
+    shards: list[int] = field(default_factory=lambda: [0, 1, 2, 3])
+
+    def validate(self) -> None:
+        check(self.maps_per_shard >= 1, "scale.maps_per_shard", self.maps_per_shard, ">= 1")
+        ok = len(set(self.shards)) == len(self.shards) and all(s >= 0 for s in self.shards)
+        check(ok and self.shards, "scale.shards", self.shards, "unique non-negative ids")
+
+    @property
+    def n_maps(self) -> int:
+        return len(self.shards) * self.maps_per_shard

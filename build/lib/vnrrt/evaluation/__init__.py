@@ -1,0 +1,1 @@
+"""Evaluation of the planners: trial statistics and the report against the paper."""

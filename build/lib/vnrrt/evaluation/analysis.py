@@ -1,0 +1,155 @@
+"""Everything the report says, computed once from the merged trial table (stage
+``evaluate``): per-cell summaries, paired speed-ups, the paper's claims with verdicts and
+convergence curves. The result is plain JSON-able data (``reports/eval/summary.json``);
+:mod:`vnrrt.evaluation.report` only renders it.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import yaml
+
+from vnrrt.evaluation.protocol import STOPS
+from vnrrt.evaluation.stats import Summary, bonferroni_level, compare, summarize, verdict
+from vnrrt.evaluation.table import CONVERGENCE_COLUMNS, CONVERGENCE_FACTORS
+
+METRICS = {"time_to_stop": True, "iterations": True, "cost": False}  # metric -> censored
+
+
+def load_paper_tables(path: str | Path) -> dict:
+    """The paper's numbers (``reports/paper/tables.yaml``: tables, quoted claims)."""
+    with open(path) as f:
+        return yaml.safe_load(f)
+
+
+def _summary(sub: pd.DataFrame, metric: str, n_boot: int, level: float) -> Summary:
+    return summarize(
+        sub[metric],
+        sub["success"],
+        sub["cluster"],
+        sub["fallback_uniform"],
+        censor=METRICS[metric],
+        n_boot=n_boot,
+        level=level,
+    )
+
+
+def cells(table: pd.DataFrame, n_boot: int = 2000, level: float = 0.95) -> dict:
+    """``{stop: {key: {map_set: {metric: Summary dict}}}}`` for time, iterations and cost."""
+    out: dict = {}
+    for (stop, key, map_set), sub in table.groupby(["stop", "key", "map_set"], sort=False):
+        out.setdefault(stop, {}).setdefault(key, {})[map_set] = {
+            m: _summary(sub, m, n_boot, level).as_dict() for m in METRICS
+        }
+    return out
+
+
+def speedups(
+    table: pd.DataFrame,
+    baseline: str,
+    metric: str = "time_to_stop",
+    n_boot: int = 2000,
+    level: float = 0.95,
+) -> dict:
+    """``{stop: {key: {map_set: Comparison dict}}}`` of every configuration against
+    ``baseline`` on the same instances."""
+    out: dict = {}
+    for (stop, map_set), sub in table.groupby(["stop", "map_set"], sort=False):
+        base = sub[sub["key"] == baseline]
+        if base.empty:
+            continue
+        for key, plan in sub.groupby("key", sort=False):
+            if key != baseline:
+                c = compare(base, plan, metric, n_boot=n_boot, level=level)
+                out.setdefault(stop, {}).setdefault(key, {})[map_set] = c.as_dict()
+    return out
+
+
+def _claim_pair(table: pd.DataFrame, paper: dict, claim: dict):
+    """(baseline rows, planner rows) of a claim's table column; None if either is missing."""
+    stop = paper["tables"][claim["table"]]["stop"]
+    sel = table[(table["stop"] == stop) & (table["map_set"] == claim["column"])]
+    base, plan = sel[sel["key"] == claim["baseline"]], sel[sel["key"] == claim["planner"]]
+    return None if base.empty or plan.empty else (base, plan)
+
+
+def claims(table: pd.DataFrame, paper: dict, n_boot: int = 2000, level: float = 0.95) -> dict:
+    """The paper's quoted improvements against ours, for time and iterations: our paired
+    speed-up and ratio of means with CIs, the verdict at ``level`` and at the
+    Bonferroni-corrected level over all tested (claim, metric) pairs, and whether the map
+    set is comparable (our named maps are not the paper's)."""
+    comparable = set(paper.get("comparable_columns", []))
+    pairs = [_claim_pair(table, paper, claim) for claim in paper["claims"]]
+    tests = 2 * sum(p is not None for p in pairs)
+    strict = bonferroni_level(level, tests)
+    rows = []
+    for claim, pair in zip(paper["claims"], pairs, strict=True):
+        row = {**claim, "comparable": claim["column"] in comparable}
+        for metric in ("time_to_stop", "iterations"):
+            if pair is None:
+                row[metric] = None
+                continue
+            c = compare(*pair, metric, n_boot=n_boot, level=level).as_dict()
+            wide = compare(*pair, metric, n_boot=n_boot, level=strict)
+            c["verdict"] = verdict(claim["quoted"], c["ci_low"] - 1, c["ci_high"] - 1)
+            c["bonferroni_ci"] = [wide.ci_low, wide.ci_high]
+            c["bonferroni_verdict"] = verdict(claim["quoted"], wide.ci_low - 1, wide.ci_high - 1)
+            row[metric] = c
+        rows.append(row)
+    return {"level": level, "tests": tests, "bonferroni_level": strict, "rows": rows}
+
+
+def convergence_curves(table: pd.DataFrame, eps: float) -> pd.DataFrame:
+    """Median time (s) at which the best cost first fell to ``factor`` x reference, per
+    optimal stop rule, configuration and map set, over all trials; a bound a trial never
+    reached enters at the trial's stop time (censored, a lower bound). The last point,
+    factor ``1 + eps``, is the stop rule. Columns: stop, planner, map_set, factor,
+    median_time."""
+    rows = []
+    opt = table[table["stop"] != "initial"]
+    for (stop, key, map_set), sub in opt.groupby(["stop", "key", "map_set"], sort=False):
+        stop_t = sub["time_to_stop"].to_numpy()
+        cols = [*CONVERGENCE_COLUMNS, "time_to_stop"]
+        for f, col in zip([*CONVERGENCE_FACTORS, 1.0 + eps], cols, strict=True):
+            t = sub[col].to_numpy()
+            median = float(np.median(np.where(np.isnan(t), stop_t, t)))
+            rows.append(
+                {
+                    "stop": stop,
+                    "planner": key,
+                    "map_set": map_set,
+                    "factor": f,
+                    "median_time": median,
+                }
+            )
+    return pd.DataFrame(rows, columns=["stop", "planner", "map_set", "factor", "median_time"])
+
+
+def analyze(
+    table: pd.DataFrame, paper: dict, eps: float, n_boot: int = 2000, level: float = 0.95
+) -> dict:
+    """The whole summary (module doc) of a merged trial table."""
+    stops = [s for s in STOPS if s in set(table["stop"])]
+    keys = list(dict.fromkeys(table["key"]))
+    return {
+        "eps": eps,
+        "stops": stops,
+        "keys": keys,
+        "map_sets": list(dict.fromkeys(table["map_set"])),
+        "cells": cells(table, n_boot, level),
+        "over_rrt_star": {
+            m: speedups(table, "rrt_star", m, n_boot, level) for m in ("time_to_stop", "iterations")
+        },
+        "over_nrrt_star": {
+            m: speedups(table, "nrrt_star", m, n_boot, level)
+            for m in ("time_to_stop", "iterations")
+        },
+        "claims": claims(table, paper, n_boot, level),
+        "setup_ms": {
+            k: float(1e3 * sub["setup_time"].median())
+            for k, sub in table.groupby("key", sort=False)
+        },
+    }

@@ -1,0 +1,1 @@
+"""Floor maps: random generation (OpenCV shapes), the five named maps, RGB rendering."""

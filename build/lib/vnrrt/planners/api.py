@@ -1,0 +1,276 @@
+"""Public entry point :func:`plan`: validate inputs, build the sampler, run the core, time it.
+
+Coordinates follow :mod:`vnrrt.grid`: ``grid`` is ``(H, W)`` indexed ``grid[y, x]``
+(nonzero = obstacle), start and goal are continuous ``(x, y)`` pixel points (cell
+centres ``(x + 0.5, y + 0.5)`` for dataset instances). Timings cover the tree
+search only: building the sampler from a heatmap (per map, once; reported as
+``setup_time``), JIT compilation (once per process, :func:`warmup`) and the reference-length
+computation (an oracle, not part of planning) are outside the timed region. A sampler can be
+built once with :func:`make_sampler` and passed to many :func:`plan` calls.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import logging
+import math
+import time
+
+import numpy as np
+
+from vnrrt.grid import GridError, as_occupancy, as_point
+from vnrrt.planners import core
+from vnrrt.planners.collision import point_free, polyline_length
+from vnrrt.planners.config import PLANNERS, PlannerConfig
+from vnrrt.planners.reference import reference_length as compute_reference
+from vnrrt.planners.result import Milestone, PlanResult
+from vnrrt.planners.samplers import Sampler, heatmap_sampler, rng_state, uniform_sampler
+
+log = logging.getLogger(__name__)
+
+FIRST_CHUNK, MAX_CHUNK = 64, 4096  # iterations per compiled call; budgets checked between
+FIRST_CAPACITY = 4096  # tree nodes allocated first; doubled when full (up to the budget)
+
+
+def make_sampler(
+    planner: str, shape: tuple[int, int], heatmap=None, tau=None, mix: float = 0.5
+) -> Sampler:
+    """The sampler of ``planner`` for an ``(H, W)`` map (see :mod:`.samplers`)."""
+    if planner not in PLANNERS:
+        raise ValueError(f"unknown planner {planner!r}; choose from {PLANNERS}")
+    if planner == "rrt_star":
+        if heatmap is not None:
+            raise ValueError("rrt_star samples uniformly and takes no heatmap")
+        return uniform_sampler(shape)
+    if heatmap is None:
+        raise ValueError(f"{planner} needs a heatmap of shape {tuple(shape)}")
+    if planner == "m_vnrrt_star":
+        if tau is None or not math.isfinite(tau):
+            raise ValueError(f"m_vnrrt_star needs a finite mask threshold tau, got {tau!r}")
+        return heatmap_sampler(heatmap, shape, mix, float(tau))
+    if tau is not None:
+        raise ValueError(f"{planner} takes no tau (only m_vnrrt_star masks its heatmap)")
+    return heatmap_sampler(heatmap, shape, mix)
+
+
+SAMPLER_KINDS = {
+    "rrt_star": "uniform",
+    "nrrt_star": "heatmap",
+    "vnrrt_star": "heatmap",
+    "m_vnrrt_star": "masked",
+}
+
+
+def check_sampler(
+    sampler: Sampler, planner: str, shape: tuple[int, int], heatmap=None, tau=None
+) -> None:
+    """Raise ``ValueError`` unless ``sampler`` is what ``planner`` samples from on a map of
+    ``shape`` (a prebuilt sampler replaces ``heatmap`` and ``tau``)."""
+    if planner not in PLANNERS:
+        raise ValueError(f"unknown planner {planner!r}; choose from {PLANNERS}")
+    if heatmap is not None or tau is not None:
+        raise ValueError("give either a prebuilt sampler or heatmap/tau, not both")
+    if sampler.kind != SAMPLER_KINDS[planner]:
+        raise ValueError(
+            f"{planner} samples from a {SAMPLER_KINDS[planner]} sampler, got a {sampler.kind} one"
+        )
+    if tuple(sampler.shape) != tuple(shape):
+        raise GridError(f"sampler is for shape {sampler.shape}, the grid has shape {shape}")
+
+
+def _check_endpoint(occ: np.ndarray, point, name: str) -> tuple[float, float]:
+    x, y = as_point(occ, point, name)
+    if not point_free(occ, (x, y)):
+        raise GridError(f"{name} {(x, y)} touches an obstacle cell or the map border")
+    return x, y
+
+
+def _params(cfg: PlannerConfig, occ: np.ndarray, goal, mix: float) -> np.ndarray:
+    params = np.zeros(8)
+    gamma = cfg.gamma
+    if gamma is None:  # RRT* bound 2 (1 + 1/d)^(1/d) (free area / unit-ball area)^(1/d), d=2
+        gamma = 2.0 * math.sqrt(1.5) * math.sqrt(np.count_nonzero(occ == 0) / math.pi)
+    params[core.P_ETA] = cfg.eta
+    params[core.P_GAMMA] = gamma if cfg.radius_mode == "shrinking" else 0.0
+    params[core.P_RADIUS] = cfg.fixed_radius
+    params[core.P_GOAL_RADIUS] = cfg.eta if cfg.goal_radius is None else cfg.goal_radius
+    params[core.P_GX], params[core.P_GY] = goal
+    params[core.P_MIX] = mix
+    params[core.P_MIN_SPACING] = cfg.min_spacing
+    return params
+
+
+def plan(
+    grid: np.ndarray,
+    start,
+    goal,
+    planner: str = "rrt_star",
+    heatmap: np.ndarray | None = None,
+    tau: float | None = None,
+    stop: str = "initial",
+    reference_length: float | None = None,
+    seed=0,
+    config: PlannerConfig | None = None,
+    milestones: tuple[float, ...] = (),
+    keep_tree: bool = False,
+    sampler: Sampler | None = None,
+    **overrides,
+) -> PlanResult:
+    """Plan from ``start`` to ``goal`` with one of the paper's RRT* variants.
+
+    Args:
+        grid: ``(H, W)`` bool/int occupancy, nonzero = obstacle, indexed ``grid[y, x]``.
+        start, goal: continuous points ``(x, y)`` in pixels, in free cells and not touching
+            an obstacle or the map border.
+        planner: ``'rrt_star'`` (uniform), ``'nrrt_star'`` / ``'vnrrt_star'`` (heatmap
+            sampler, Algorithm 2) or ``'m_vnrrt_star'`` (heatmap masked below ``tau``).
+        heatmap: ``(H, W)`` non-negative sampling weights, needed by all but RRT*.
+        tau: mask threshold for M-VNRRT* (defaults to ``config.tau``).
+        stop: ``'initial'`` (first solution) or ``'optimal'`` (cost <= (1 + eps) x ref).
+        reference_length: reference for ``'optimal'``; None computes ``config.reference``
+            (A* length by default) between the cells containing start and goal.
+        seed: int or tuple of ints seeding the sampler (same seed, same result).
+        config: settings (default :class:`PlannerConfig`); ``overrides`` replace fields,
+            e.g. ``eta=5.0, max_seconds=2``.
+        milestones: extra cost bounds (pixels) whose first-reach time is recorded.
+        keep_tree: also return the tree (points and parents) for drawing.
+        sampler: a sampler already built by :func:`make_sampler` for this planner and map
+            (then ``heatmap`` and ``tau`` are not given); saves rebuilding it per run.
+
+    Returns:
+        A :class:`PlanResult`; hitting an iteration or time budget gives ``success=False``.
+
+    Raises:
+        GridError: malformed grid, bad start/goal, heatmap of the wrong shape or values.
+        NoPathError: the A* reference is needed and start and goal are not connected.
+        ValueError: unknown planner or stop rule, bad settings.
+    """
+    cfg = (config or PlannerConfig()).replace(**overrides)
+    occ = as_occupancy(grid)
+    start = _check_endpoint(occ, start, "start")
+    goal = _check_endpoint(occ, goal, "goal")
+    if stop not in ("initial", "optimal"):
+        raise ValueError(f"unknown stop rule {stop!r}; use 'initial' or 'optimal'")
+    if planner == "m_vnrrt_star" and tau is None and sampler is None:
+        tau = cfg.tau
+    t0 = time.perf_counter()
+    if sampler is None:
+        sampler = make_sampler(planner, occ.shape, heatmap, tau, cfg.mix)
+    else:
+        check_sampler(sampler, planner, occ.shape, heatmap, tau)
+    setup = time.perf_counter() - t0
+    if reference_length is None and stop == "optimal":
+        reference_length = compute_reference(occ, start, goal, cfg.reference)
+    if reference_length is not None and not (
+        math.isfinite(reference_length) and reference_length >= 0
+    ):
+        raise ValueError(f"reference_length must be finite and >= 0, got {reference_length}")
+    target = None if stop == "initial" else (1.0 + cfg.eps) * reference_length
+    warmup()
+    result = _timed(occ, start, goal, planner, sampler, target, milestones, seed, cfg, keep_tree)
+    result = dataclasses.replace(result, reference_length=reference_length, setup_time=setup)
+    log.debug("%s", result.summary())
+    return result
+
+
+def _timed(occ, start, goal, planner, sampler, target, milestones, seed, cfg, keep_tree):
+    """The timed part of :func:`plan` on validated inputs; ``target`` None = first solution."""
+    bounds = tuple(float(m) for m in milestones)
+    t0 = time.perf_counter()
+    capacity = min(cfg.max_iterations + 2, FIRST_CAPACITY)
+    tree = core.Tree(capacity, occ.shape, max(cfg.eta / 2, 1.0), cfg.trace_capacity)
+    wanted = {math.inf, *bounds, *([] if target is None else [target])}
+    stops = np.array(sorted(wanted, reverse=True))
+    reason, times, iters = _drive(tree, occ, sampler, start, goal, stops, target, seed, cfg, t0)
+    elapsed = time.perf_counter() - t0
+    reached = {b: (float(t), int(i)) for b, t, i in zip(stops, times, iters, strict=True)}
+    result = _result(tree, planner, reason, reached, elapsed, keep_tree)
+    extra = tuple(Milestone(b, *reached[b]) for b in bounds)
+    return dataclasses.replace(
+        result, target_cost=target, milestones=extra, fallback_uniform=sampler.fallback_uniform
+    )
+
+
+def _drive(tree, occ, sampler, start, goal, stops, target, seed, cfg, t0):
+    """Grow ``tree`` in compiled chunks until the stop rule or a budget is met.
+
+    Returns ``(stop_reason, times, iterations)``: per entry of ``stops`` (decreasing cost
+    bounds), the time (s since ``t0``) and iteration at which it was first reached.
+    """
+    rng = rng_state(seed)
+    params = _params(cfg, occ, goal, sampler.mix)
+    cdf = sampler.cdf if sampler.cdf.size else np.zeros(1)
+    sampler_args = (cdf, max(sampler.last, 0))
+    c = tree.counters
+    tree.add_root(*start)
+    args = (occ, tree.pts, tree.cost, tree.links, c, tree.stack, 0, *goal)
+    core.connect_goal(*args, params[core.P_GOAL_RADIUS])  # the start may see the goal
+    core.record(c, tree.cost, tree.trace_it, tree.trace_cost, stops)
+    times, iters = np.full(len(stops), math.nan), np.full(len(stops), -1, np.int64)
+    stop_bound = math.inf if target is None else target
+    chunk, passed, status = FIRST_CHUNK, 0, core.RUNNING
+    while True:
+        now = time.perf_counter() - t0
+        times[passed : c[core.MILESTONE]] = now
+        iters[passed : c[core.MILESTONE]] = c[core.ITERS]
+        passed = c[core.MILESTONE]
+        if c[core.GOAL] >= 0 and tree.cost[c[core.GOAL]] <= stop_bound:
+            return "solved", times, iters
+        if status == core.TREE_FULL:
+            if tree.capacity >= cfg.max_iterations + 2:
+                return "tree_full", times, iters
+            tree.grow(min(2 * tree.capacity, cfg.max_iterations + 2))
+            status = core.RUNNING
+        if c[core.ITERS] >= cfg.max_iterations:
+            return "max_iterations", times, iters
+        if now >= cfg.max_seconds:
+            return "max_seconds", times, iters
+        n = min(chunk, cfg.max_iterations - c[core.ITERS])
+        status = core.run_chunk(tree, occ, sampler_args, rng, stops, params, n)
+        chunk = min(2 * chunk, MAX_CHUNK)
+
+
+def _result(tree, planner, reason, reached, elapsed, keep_tree) -> PlanResult:
+    """Assemble a :class:`PlanResult` from a finished tree (stop-rule fields left empty)."""
+    c = tree.counters
+    n, g, k = int(c[core.N_NODES]), int(c[core.GOAL]), int(c[core.TRACE_LEN])
+    path = core.branch(tree.links, tree.pts, g) if g >= 0 else np.zeros((0, 2))
+    cost = polyline_length(path) if g >= 0 else math.inf
+    trace_it, trace_cost = tree.trace_it[:k].copy(), tree.trace_cost[:k].copy()
+    if k and trace_cost[-1] != tree.cost[g]:
+        trace_it = np.append(trace_it, c[core.ITERS])
+        trace_cost = np.append(trace_cost, tree.cost[g])
+    first_time, first_iter = reached[math.inf]
+    return PlanResult(
+        planner=planner,
+        success=reason == "solved",
+        stop_reason=reason,
+        path=path,
+        cost=cost,
+        iterations=int(c[core.ITERS]),
+        tree_size=n,
+        collision_checks=int(c[core.CHECKS]),
+        time_to_first=first_time,
+        time_to_stop=elapsed,
+        first_cost=float(trace_cost[0]) if k else math.inf,
+        first_iteration=first_iter,
+        trace_iterations=trace_it,
+        trace_costs=trace_cost,
+        tree_points=tree.pts[:n].copy() if keep_tree else None,
+        tree_parents=tree.links[:n, core.PARENT].copy() if keep_tree else None,
+    )
+
+
+@functools.cache
+def warmup() -> None:
+    """Compile (or load from numba's disk cache) every kernel once per process, so that
+    reported timings exclude JIT compilation."""
+    occ = np.zeros((8, 8), np.uint8)
+    occ[2:6, 4] = 1
+    cfg = PlannerConfig(max_iterations=200)
+    heat = np.ones((8, 8))
+    for planner, hm in (("rrt_star", None), ("vnrrt_star", heat)):
+        sampler = make_sampler(planner, occ.shape, hm)
+        _timed(occ, (1.5, 3.5), (6.5, 3.5), planner, sampler, 0.0, (), 0, cfg, False)
+    log.debug("planner kernels compiled")

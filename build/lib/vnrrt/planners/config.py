@@ -1,0 +1,110 @@
+"""Planner settings: the typed mirror of ``conf/planner/default.yaml`` (lengths in pixels).
+
+Kept free of Hydra/OmegaConf so that :mod:`vnrrt.planners` depends only on
+:mod:`vnrrt.grid` and :mod:`vnrrt.search`; ``vnrrt.config.section(cfg, "planner",
+PlannerConfig)`` validates the composed YAML against this dataclass.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass, field
+
+PLANNERS = ("rrt_star", "nrrt_star", "vnrrt_star", "m_vnrrt_star")
+REFERENCES = ("astar", "any_angle", "taut")
+RADIUS_MODES = ("shrinking", "fixed")
+
+
+class PlannerConfigError(ValueError):
+    """A planner setting is invalid; the message names it."""
+
+
+@dataclass
+class PlannerConfig:
+    """RRT* core, samplers, stop rules and budgets (paper, Background and VertexNet RRT*).
+
+    Attributes:
+        eta: Steer step (pixels).
+        radius_mode: ``'shrinking'``: near radius ``min(gamma sqrt(log n / n), eta)``;
+            ``'fixed'``: ``fixed_radius``.
+        gamma: shrinking-radius constant; ``None`` uses the RRT* bound
+            ``2 sqrt(1.5) sqrt(free area / pi)`` of the map (Karaman and Frazzoli).
+        fixed_radius: near radius in ``'fixed'`` mode (pixels).
+        goal_radius: a node within this distance connects to the goal point by a
+            collision-free straight segment; ``None`` means ``eta``.
+        mix: probability of a heatmap draw in NRRT*/VNRRT*/M-VNRRT* (Algorithm 2: 0.5).
+        tau: default mask threshold of M-VNRRT* when ``plan`` gets none.
+        taus: thresholds evaluated for M-VNRRT* (paper: 0.5, 0.9, 0.99).
+        eps: stop rule ``optimal``: best cost <= (1 + eps) x reference length.
+        reference: ``'astar'`` (paper: 8-connected A* length), ``'any_angle'`` (the exact
+            continuous optimum among closed obstacle cells, :func:`vnrrt.search.any_angle_length`)
+            or ``'taut'`` (the A* path pulled taut: an approximation, 0-6% above the exact).
+        min_spacing: a sample within this distance (pixels) of its nearest node adds no
+            node (the iteration counts). Without it, a concentrated heatmap (M-VNRRT*)
+            draws many samples inside the same few pixels, RRT* piles nodes up there and
+            every near search and rewire grows with the pile; 0 disables it.
+        max_iterations, max_seconds: budgets; hitting one is a recorded failure.
+        trace_capacity: most points kept in the sparse cost-versus-iteration trace.
+    """
+
+    eta: float = 10.0
+    radius_mode: str = "shrinking"
+    gamma: float | None = None
+    fixed_radius: float = 10.0
+    goal_radius: float | None = None
+    mix: float = 0.5
+    tau: float = 0.5
+    taus: list[float] = field(default_factory=lambda: [0.5, 0.9, 0.99])
+    eps: float = 0.01
+    reference: str = "astar"
+    min_spacing: float = 0.5
+    max_iterations: int = 200_000
+    max_seconds: float = 30.0
+    trace_capacity: int = 1024
+
+    def validate(self) -> None:
+        """Raise :class:`PlannerConfigError` naming the first invalid value."""
+        for name in ("eta", "fixed_radius", "max_seconds"):
+            v = getattr(self, name)
+            self._check(name, _finite(v) and v > 0, "> 0")
+        for name in ("gamma", "goal_radius"):
+            v = getattr(self, name)
+            self._check(name, v is None or (_finite(v) and v > 0), "null or > 0")
+        self._check("radius_mode", self.radius_mode in RADIUS_MODES, f"one of {RADIUS_MODES}")
+        self._check("reference", self.reference in REFERENCES, f"one of {REFERENCES}")
+        self._check("mix", _finite(self.mix) and 0.0 <= self.mix <= 1.0, "in [0, 1]")
+        self._check("eps", _finite(self.eps) and self.eps >= 0, ">= 0")
+        ok = _finite(self.min_spacing) and 0 <= self.min_spacing < self.eta
+        self._check("min_spacing", ok, ">= 0 and < eta")
+        ok = _integer(self.max_iterations) and self.max_iterations >= 1
+        self._check("max_iterations", ok, "an integer >= 1")
+        ok = _integer(self.trace_capacity) and self.trace_capacity >= 2
+        self._check("trace_capacity", ok, "an integer >= 2")
+        self._check("tau", _finite(self.tau), "finite")
+        self._check("taus", all(_finite(t) for t in self.taus), "finite values")
+
+    def _check(self, name: str, ok: bool, why: str) -> None:
+        if not ok:
+            value = getattr(self, name)
+            raise PlannerConfigError(f"invalid planner setting {name}={value!r}: must be {why}")
+
+    def replace(self, **changes) -> PlannerConfig:
+        """A validated copy with ``changes`` applied; unknown names raise an error."""
+        known = {f.name for f in dataclasses.fields(self)}
+        unknown = sorted(set(changes) - known)
+        if unknown:
+            raise PlannerConfigError(
+                f"unknown planner setting(s) {unknown}; known: {sorted(known)}"
+            )
+        new = dataclasses.replace(self, **changes)
+        new.validate()
+        return new
+
+
+def _integer(v) -> bool:
+    return isinstance(v, int) and not isinstance(v, bool)
+
+
+def _finite(v) -> bool:
+    return isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)

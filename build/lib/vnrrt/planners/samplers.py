@@ -1,0 +1,145 @@
+"""Samplers for the RRT* core: uniform, heatmap (NRRT*/VNRRT*) and masked (M-VNRRT*).
+
+Every sampler is the same small piece of data, a :class:`Sampler`, read by one compiled
+function, :func:`sample_point`: with probability ``mix`` a point is drawn from the
+heatmap (a pixel with probability proportional to its weight, then a uniform point
+inside that pixel), otherwise uniformly from the whole map ``[0, W) x [0, H)``
+(obstacles included, as in Algorithm 1). The uniform sampler is ``mix = 0``.
+
+* ``uniform`` (RRT*): ``mix = 0``.
+* ``heatmap`` (NRRT* with a path heatmap, VNRRT* with a vertex heatmap; Algorithm 2):
+  weights = the heatmap, ``mix = 0.5`` by default.
+* ``masked`` (M-VNRRT*): weights = the heatmap with values below ``tau`` set to zero.
+
+If no positive weight is left, the sampler falls back to uniform (``mix = 0``) and sets
+``fallback_uniform``. Randomness comes from a xoshiro256** generator whose 4-word
+``uint64`` state is seeded with :class:`numpy.random.SeedSequence`; no global state.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+
+from vnrrt.grid import GridError
+
+_INV_2_53 = 1.0 / 9007199254740992.0
+
+
+def rng_state(seed) -> np.ndarray:
+    """Fresh xoshiro256** state ``(4,)`` uint64 derived from ``seed`` (int or int tuple)."""
+    state = np.random.SeedSequence(seed).generate_state(4, dtype=np.uint64)
+    if not state.any():  # the all-zero state is the one invalid xoshiro state
+        state[0] = 1
+    return state
+
+
+@njit(cache=True, inline="always")
+def _rotl(x, k):
+    return (x << np.uint64(k)) | (x >> np.uint64(64 - k))
+
+
+@njit(cache=True)
+def next_double(s: np.ndarray) -> float:
+    """Advance xoshiro256** state ``s`` (4,) uint64; return a float in ``[0, 1)``."""
+    result = _rotl(s[1] * np.uint64(5), 7) * np.uint64(9)
+    t = s[1] << np.uint64(17)
+    s[2] ^= s[0]
+    s[3] ^= s[1]
+    s[1] ^= s[2]
+    s[0] ^= s[3]
+    s[2] ^= t
+    s[3] = _rotl(s[3], 45)
+    return float(result >> np.uint64(11)) * _INV_2_53
+
+
+@dataclass(frozen=True)
+class Sampler:
+    """A sampling distribution over an ``(H, W)`` map.
+
+    Attributes:
+        kind: ``'uniform'``, ``'heatmap'`` or ``'masked'``.
+        mix: probability of a heatmap draw (0 for uniform or after a fallback).
+        cdf: ``(H*W,)`` float64 cumulative weights over flat pixels ``y * W + x``
+            (empty for uniform).
+        last: index of the last pixel with positive weight (-1 for uniform).
+        shape: ``(H, W)`` of the map.
+        fallback_uniform: True when a heatmap sampler had no positive weight left.
+    """
+
+    kind: str
+    mix: float
+    cdf: np.ndarray
+    last: int
+    shape: tuple[int, int]
+    fallback_uniform: bool = False
+
+
+def uniform_sampler(shape: tuple[int, int]) -> Sampler:
+    """Uniform sampler over the ``(H, W)`` map."""
+    return Sampler("uniform", 0.0, np.zeros(0), -1, (int(shape[0]), int(shape[1])))
+
+
+def heatmap_sampler(
+    heatmap: np.ndarray, shape: tuple[int, int], mix: float = 0.5, tau: float | None = None
+) -> Sampler:
+    """Heatmap sampler (``tau=None``) or masked sampler (weights below ``tau`` zeroed).
+
+    Args:
+        heatmap: ``(H, W)`` finite non-negative values (probabilities or scores), indexed
+            ``heatmap[y, x]`` like the grid.
+        shape: ``(H, W)`` of the grid; the heatmap must match it.
+        mix: probability of drawing from the heatmap in each sample (Algorithm 2: 0.5).
+        tau: mask threshold of M-VNRRT*; pixels with value ``< tau`` get zero weight.
+    """
+    hm = np.asarray(heatmap)
+    if hm.shape != tuple(shape):
+        raise GridError(f"heatmap has shape {hm.shape}, the grid has shape {tuple(shape)}")
+    if not np.issubdtype(hm.dtype, np.number) or np.issubdtype(hm.dtype, np.complexfloating):
+        raise GridError(f"heatmap must be real numbers, got dtype {hm.dtype}")
+    hm = hm.astype(np.float64)
+    if not np.all(np.isfinite(hm)) or hm.min() < 0:
+        raise GridError("heatmap values must be finite and >= 0")
+    if not 0.0 <= mix <= 1.0:
+        raise ValueError(f"mix must be in [0, 1], got {mix}")
+    weights = hm if tau is None else np.where(hm >= tau, hm, 0.0)
+    kind = "heatmap" if tau is None else "masked"
+    flat = weights.ravel()
+    positive = np.flatnonzero(flat > 0)
+    if positive.size == 0:
+        return Sampler(kind, 0.0, np.zeros(0), -1, tuple(shape), fallback_uniform=True)
+    return Sampler(kind, float(mix), np.cumsum(flat), int(positive[-1]), tuple(shape))
+
+
+@njit(cache=True, inline="always")
+def _below(v, hi):
+    """``v`` clamped under ``hi`` (rounding of ``lo + u`` may reach ``hi`` when u ~ 1)."""
+    return v if v < hi else hi - 1e-9
+
+
+@njit(cache=True)
+def sample_point(s, h, w, mix, cdf, last):
+    """One sample ``(x, y)`` in pixels (see module doc); ``s`` is the rng state."""
+    if mix > 0.0 and next_double(s) < mix:
+        u = next_double(s) * cdf[last]
+        i = min(np.searchsorted(cdf, u, side="right"), last)
+        px, py = float(i % w), float(i // w)
+        return _below(px + next_double(s), px + 1.0), _below(py + next_double(s), py + 1.0)
+    return _below(next_double(s) * w, float(w)), _below(next_double(s) * h, float(h))
+
+
+@njit(cache=True)
+def _draw(s, n, h, w, mix, cdf, last):
+    out = np.empty((n, 2))
+    for k in range(n):
+        out[k, 0], out[k, 1] = sample_point(s, h, w, mix, cdf, last)
+    return out
+
+
+def draw(sampler: Sampler, n: int, seed=0) -> np.ndarray:
+    """``n`` samples ``(n, 2)`` float64 (x, y) in pixels from ``sampler`` (for tests, plots)."""
+    h, w = sampler.shape
+    cdf = sampler.cdf if sampler.cdf.size else np.zeros(1)
+    return _draw(rng_state(seed), int(n), h, w, sampler.mix, cdf, max(sampler.last, 0))

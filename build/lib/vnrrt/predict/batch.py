@@ -1,0 +1,69 @@
+"""Batch prediction of the evaluation instances and the heatmap metrics.
+
+Inputs are rendered from the instances file (:mod:`vnrrt.evaluation.instances`) exactly as
+in training (the checkpoint's record), so prediction needs neither the shards nor a data
+loader. Heatmaps are stored as float16 (:mod:`vnrrt.data.heatmaps`).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import time
+
+import numpy as np
+import torch
+
+from vnrrt.maps.render import render_instance
+from vnrrt.model.metrics import metric_collection
+from vnrrt.search import path_mask
+
+
+def inputs(instances, rows, render: dict) -> np.ndarray:
+    """Network inputs ``(N, 3, S, S)`` float32 of instances ``rows`` of an
+    :class:`~vnrrt.evaluation.instances.Instances` file."""
+    out = []
+    for i in rows:
+        inst = instances[int(i)]
+        out.append(render_instance(inst.grid, inst.start_cell, inst.goal_cell, **render))
+    size = instances.size
+    return np.stack(out) if out else np.zeros((0, 3, size, size), np.float32)
+
+
+@torch.inference_mode()
+def predict(
+    net: torch.nn.Module, images: np.ndarray, batch_size: int, device: torch.device
+) -> tuple[np.ndarray, float]:
+    """Probabilities ``(N, S, S)`` float16 of ``images`` ``(N, 3, S, S)`` and the network's
+    seconds per map (bf16 autocast on CUDA)."""
+    net = net.to(device).eval()
+    autocast = torch.autocast("cuda", torch.bfloat16) if device.type == "cuda" else None
+    out, seconds = [], 0.0
+    for start in range(0, len(images), batch_size):
+        x = torch.from_numpy(images[start : start + batch_size]).to(device)
+        tick = time.perf_counter()
+        with autocast or contextlib.nullcontext():
+            probs = net(x).float().softmax(dim=1)[:, 1]  # (B, S, S)
+        probs = probs.cpu()
+        seconds += time.perf_counter() - tick
+        out.append(probs.numpy().astype(np.float16))
+    size = images.shape[-1]
+    maps = np.concatenate(out) if out else np.zeros((0, size, size), np.float16)
+    return maps, seconds / max(len(images), 1)
+
+
+def heatmap_metrics(
+    maps: np.ndarray, instances, rows, radius: float = 3.0, tau: float = 0.5
+) -> dict[str, float]:
+    """Heatmap metrics (:func:`vnrrt.model.metrics.heatmap_metrics`, within ``radius`` px,
+    recall at ``tau``) of ``maps`` ``(N, S, S)`` against the A* paths and vertices of
+    instances ``rows``."""
+    metrics = metric_collection(radius, tau, with_target=False)
+    shape = (instances.size, instances.size)
+    for k, i in enumerate(rows):
+        inst = instances[int(i)]
+        metrics.update(
+            preds=torch.from_numpy(maps[k : k + 1].astype(np.float32)),
+            vertices=torch.from_numpy(path_mask(inst.vertices, shape))[None],
+            path=torch.from_numpy(path_mask(inst.path, shape))[None],
+        )
+    return {k: float(v) for k, v in metrics.compute().items()}

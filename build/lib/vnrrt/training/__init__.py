@@ -1,0 +1,1 @@
+"""Training of VertexNet and the NRRT* network: Lightning, Hydra-instantiated objects, MLflow."""

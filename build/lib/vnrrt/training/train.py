@@ -1,0 +1,74 @@
+"""Fit one network with ready objects (a LightningModule, a DataModule and a Trainer) and
+write its outputs: the final checkpoint (atomically), the metrics JSON and, through the
+trainer's MLflow logger, the run. Nothing here reads configuration; :mod:`.stage` builds
+the objects from it.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import time
+from pathlib import Path
+
+import lightning as L
+import torch
+
+from vnrrt.io import write_json
+
+log = logging.getLogger(__name__)
+
+
+def resolve_precision(precision: str | int, accelerator: str) -> str | int:
+    """``"auto"``: ``"bf16-mixed"`` when training on a CUDA GPU, else ``"32-true"``."""
+    if str(precision) != "auto":
+        return precision
+    gpu = accelerator in ("gpu", "cuda") or (accelerator == "auto" and torch.cuda.is_available())
+    return "bf16-mixed" if gpu else "32-true"
+
+
+def save_final(trainer: L.Trainer, out: Path) -> None:
+    """Write the final checkpoint to ``out`` atomically (every rank calls, rank 0 writes)."""
+    tmp = out.with_name(f"{out.name}.tmp-{os.getpid()}")
+    trainer.save_checkpoint(tmp)
+    if trainer.is_global_zero:
+        os.replace(tmp, out)
+
+
+def summary(trainer: L.Trainer, tested: dict, seconds: float, batch_size: int) -> dict:
+    """Metrics of a run: final val metrics, test metrics, steps, time, throughput."""
+    val = {k: float(v) for k, v in trainer.callback_metrics.items() if k.startswith("val/")}
+    images = trainer.global_step * batch_size * trainer.world_size
+    return {
+        **val,
+        **{k: float(v) for k, v in tested.items()},
+        "epochs": trainer.current_epoch,
+        "steps": trainer.global_step,
+        "train_images": images,
+        "fit_seconds": seconds,
+        "train_images_per_s": images / max(seconds, 1e-9),
+    }
+
+
+def fit(
+    module: L.LightningModule,
+    datamodule: L.LightningDataModule,
+    trainer: L.Trainer,
+    out: Path,
+    metrics_file: Path,
+    batch_size: int,
+    resume: Path | None = None,
+) -> dict:
+    """Train ``module`` (from ``resume``, a Lightning checkpoint, if given), write the final
+    checkpoint to ``out``, test it and write the metrics to ``metrics_file``; returns them."""
+    start = time.perf_counter()
+    trainer.fit(module, datamodule=datamodule, ckpt_path=None if resume is None else str(resume))
+    seconds = time.perf_counter() - start
+    out.parent.mkdir(parents=True, exist_ok=True)
+    save_final(trainer, out)
+    tested = trainer.test(module, datamodule=datamodule, verbose=False)[0]
+    metrics = summary(trainer, tested, seconds, batch_size)
+    if trainer.is_global_zero:
+        write_json(metrics_file, metrics)
+        log.info("%s: %s", out.stem, {k: round(v, 4) for k, v in metrics.items()})
+    return metrics

@@ -1,0 +1,112 @@
+"""Figures of "what each sampling idea can give": the heatmap-quality curve and the regime
+sweep's speed-ups."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib.pyplot as plt
+import numpy as np
+import pandas as pd
+from matplotlib.ticker import FuncFormatter, NullFormatter
+
+from vnrrt.names import STOP_NAMES, display_name
+from vnrrt.viz.common import save_figure
+
+IDEA_NAMES = {"oracle_path": "path oracle", "oracle_vertex": "vertex oracle"}
+
+
+def quality_figure(curves: pd.DataFrame, networks: pd.DataFrame, metric: str = "iterations"):
+    """Speed-up over RRT* (log axis, whiskers: CI) against the heatmap's mass near its
+    target, one curve per idea and sampler (points: signal fractions q), one panel per stop
+    rule; the trained networks as labelled stars at their own measured mass. Returns it."""
+    stops = [s for s in STOP_NAMES if s in set(curves["stop"])]
+    fig, axes = plt.subplots(1, len(stops), figsize=(4.6 * len(stops), 4.2), squeeze=False)
+    for ax, stop in zip(axes[0], stops, strict=True):
+        sub = curves[(curves["stop"] == stop) & (curves["metric"] == metric)]
+        for (idea, conf), rows in sub.groupby(["idea", "configuration"], sort=False):
+            rows = rows.sort_values("heat_mass")
+            err = [rows["speedup"] - rows["ci_low"], rows["ci_high"] - rows["speedup"]]
+            label = f"{display_name(conf)}, {IDEA_NAMES.get(idea, idea)}"
+            ax.errorbar(
+                rows["heat_mass"],
+                rows["speedup"],
+                yerr=err,
+                marker="o",
+                ms=3,
+                capsize=2,
+                label=label,
+            )
+        nets = networks[(networks["stop"] == stop) & (networks["metric"] == metric)]
+        for _, row in nets.iterrows():
+            ax.plot(row["heat_mass"], row["speedup"], "*", ms=12, color="black")
+            ax.annotate(
+                display_name(row["configuration"]),
+                (row["heat_mass"], row["speedup"]),
+                fontsize=7,
+                xytext=(4, 4),
+                textcoords="offset points",
+            )
+        ax.axhline(1.0, color="grey", lw=0.8)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        for axis in (ax.xaxis, ax.yaxis):
+            axis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+            axis.set_minor_formatter(NullFormatter())
+        ax.set_xlabel("heatmap mass within 3 px of its target")
+        ax.set_title(STOP_NAMES[stop], fontsize=9)
+    axes[0, 0].set_ylabel(f"speed-up over RRT* ({metric.replace('time_to_stop', 'time')})")
+    handles, labels = axes[0, 0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="lower center", ncol=3, fontsize=7, bbox_to_anchor=(0.5, -0.08))
+    fig.suptitle(
+        "How good must a heatmap be? Speed-up against heatmap quality "
+        "(points: signal fraction q; stars: the trained networks; whiskers: 95% CI)",
+        fontsize=9,
+    )
+    fig.tight_layout(rect=(0, 0.05, 1, 1))
+    return fig
+
+
+def regime_figure(cells: pd.DataFrame, stop: str, eps: float = 0.01):
+    """Speed-up over RRT* per regime cell (rows) and configuration (columns), log colour
+    scale, ``*`` where the CI excludes 1. Returns the figure."""
+    sub = cells[(cells["stop"] == stop) & (cells["eps"] == eps)]
+    regimes = list(dict.fromkeys(sub["regime"]))
+    confs = list(dict.fromkeys(sub["configuration"]))
+    grid = np.full((len(regimes), len(confs)), np.nan)
+    sig = np.zeros_like(grid, bool)
+    for _, r in sub.iterrows():
+        i, j = regimes.index(r["regime"]), confs.index(r["configuration"])
+        grid[i, j] = np.log2(r["speedup"])
+        sig[i, j] = r["ci_low"] > 1 or r["ci_high"] < 1
+    lim = max(1.0, float(np.nanmax(np.abs(grid)))) if np.isfinite(grid).any() else 1.0
+    fig, ax = plt.subplots(figsize=(1.3 * len(confs) + 3.5, 0.38 * len(regimes) + 2.0))
+    image = ax.imshow(grid, cmap="RdBu", vmin=-lim, vmax=lim, aspect="auto")
+    for i in range(len(regimes)):
+        for j in range(len(confs)):
+            if np.isfinite(grid[i, j]):
+                text = f"{2 ** grid[i, j]:.2f}{'*' if sig[i, j] else ''}"
+                ax.text(j, i, text, ha="center", va="center", fontsize=7)
+    ax.set_xticks(
+        range(len(confs)), [display_name(c) for c in confs], rotation=30, ha="right", fontsize=7
+    )
+    ax.set_yticks(range(len(regimes)), regimes, fontsize=7)
+    bar = fig.colorbar(image, ax=ax)
+    bar.set_label("log2 speed-up over RRT* (blue: faster)")
+    ax.set_title(
+        f"Time speed-up over RRT*, {STOP_NAMES.get(stop, stop)} (eps {eps:g}); "
+        "* = 95% CI excludes 1",
+        fontsize=9,
+    )
+    fig.tight_layout()
+    return fig
+
+
+def save_quality(out_png: str | Path, curves, networks, metric: str = "iterations") -> None:
+    """:func:`quality_figure` saved as a PNG."""
+    save_figure(quality_figure(curves, networks, metric), out_png)
+
+
+def save_regime(out_png: str | Path, cells, stop: str, eps: float = 0.01) -> None:
+    """:func:`regime_figure` saved as a PNG."""
+    save_figure(regime_figure(cells, stop, eps), out_png)

@@ -1,0 +1,35 @@
+"""Fig. 4: the five named maps with their optimal paths and vertices."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib.pyplot as plt
+import numpy as np
+
+from vnrrt.names import map_set_title
+from vnrrt.viz.common import plot_floor_map, save_figure
+
+
+def save_named_maps(shard_path: str | Path, out_png: str | Path) -> None:
+    """Fig. 4 from a named-maps shard: each map with its A* path, vertices, start and goal."""
+    from vnrrt.data.reader import Shard
+
+    shard = Shard(shard_path)
+    names = shard.meta.get("names", [str(i) for i in range(shard.n_maps)])
+    fig, axes = plt.subplots(1, shard.n_instances, figsize=(3.2 * shard.n_instances, 3.5))
+    for i, ax in enumerate(np.atleast_1d(axes)):
+        inst = shard.instance(i)
+        title = f"{map_set_title(f'map_{i + 1}', names[inst['map_index']])}\n"
+        title += f"A* length {inst['length']:.1f} px"
+        plot_floor_map(
+            ax,
+            shard.grid(inst["map_index"]),
+            shard.path(i),
+            shard.vertices(i),
+            inst["start"],
+            inst["goal"],
+            title,
+        )
+    fig.tight_layout()
+    save_figure(fig, out_png)

@@ -1,0 +1,44 @@
+"""vnrrt works outside the repository: a wheel installed into a fresh virtual environment
+runs `vnrrt plan` on a PNG map from another folder (no conf/, no source tree)."""
+
+import site
+import subprocess
+import sys
+import venv
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+
+def test_the_wheel_plans_outside_the_repository(repo, tmp_path):
+    subprocess.run([sys.executable, "-m", "pip", "wheel", "--no-deps", "--no-build-isolation",
+                    "-q", "-w", str(tmp_path / "dist"), str(repo)], check=True,
+                   capture_output=True)  # fmt: skip
+    wheel = next((tmp_path / "dist").glob("vnrrt-*.whl"))
+    env_dir = tmp_path / "env"
+    venv.create(env_dir, with_pip=False)
+    py = env_dir / "bin" / "python"
+    code = "import sysconfig; print(sysconfig.get_paths()['purelib'])"
+    purelib = subprocess.run([py, "-c", code], capture_output=True, text=True, check=True)
+    purelib = purelib.stdout.strip()
+    # the dependencies from this environment (a path line: its .pth files, among them the
+    # editable install of the repository, are not run), vnrrt itself from the wheel
+    deps = [p for p in site.getsitepackages() if Path(p).is_dir()]
+    Path(purelib, "deps.pth").write_text("\n".join(deps) + "\n")
+    subprocess.run([sys.executable, "-m", "pip", "install", "--no-deps", "-q", "--target",
+                    purelib, str(wheel)], check=True, capture_output=True)  # fmt: skip
+    work = tmp_path / "elsewhere"
+    work.mkdir()
+    img = np.full((60, 60), 255, np.uint8)
+    img[10:50, 28:32] = 0  # a dark wall
+    cv2.imwrite(str(work / "map.png"), img)
+    where = subprocess.run([py, "-c", "import vnrrt, sys; print(vnrrt.__file__)"], cwd=work,
+                           capture_output=True, text=True, check=True).stdout  # fmt: skip
+    assert str(repo) not in where and purelib in where
+    assert Path(purelib, "vnrrt", "py.typed").is_file()
+    out = subprocess.run([py, "-m", "vnrrt", "plan", "--map", "map.png", "--start", "5.5,30.5",
+                          "--goal", "55.5,30.5", "--stop", "optimal", "--out", "plan.png"],
+                         cwd=work, capture_output=True, text=True)  # fmt: skip
+    assert out.returncode == 0, out.stdout + out.stderr
+    assert "success=True" in out.stdout and (work / "plan.png").stat().st_size > 3000
