@@ -122,7 +122,10 @@ def test_trial_parts_merge_into_the_protocol_table(cfg, repo):
     summary = run_evaluate(view(cfg, "evaluate", repo))
     table = read_table(cfg.paths.trials_table)
     n_configs = 3 + len({0.5, 0.9, 0.99, cfg.planner.tau})
-    assert len(table) == sum(sizes) == n_configs * (5 * (3 + 2 + 2) + 3 * (1 + 1 + 1))
+    paper = n_configs * (5 * (3 + 2 + 2) + 3 * (1 + 1 + 1))
+    informed = n_configs * 3 * (1 + 1 + 1)  # each again informed, random instances only
+    assert len(table) == sum(sizes) == paper + informed
+    assert set(table.loc[table["key"].str.endswith("+informed"), "map_set"]) == {"random"}
     assert min(sizes) > 0.2 * max(sizes)  # round robin: parts of similar size
     strict = table[table["stop"] == "optimal_any_angle"].reset_index()
     loose = table[table["stop"] == "optimal"].reset_index()
@@ -173,6 +176,8 @@ def test_report_stage_writes_report_figures_metrics_and_nested_mlflow_runs(cfg, 
         "different map: not comparable",
         "| NRRT* | ours |",
         "| M-VNRRT* τ=0.5 | ours |",
+        "## Informed sampling",
+        "| informed VNRRT* |",
     ):
         assert section in text, section
     assert "<br>" not in text
@@ -197,9 +202,10 @@ def test_report_stage_writes_report_figures_metrics_and_nested_mlflow_runs(cfg, 
     assert "tags.training_run.vertexnet" in parent
     children = runs[nested]
     assert set(children["tags.mlflow.parentRunId"]) == {parent["run_id"].iloc[0]}
-    keys = {"rrt_star", "nrrt_star", "vnrrt_star"} | {
+    paper = {"rrt_star", "nrrt_star", "vnrrt_star"} | {
         f"m_vnrrt_star@{t:g}" for t in {0.5, 0.9, 0.99, cfg.planner.tau}
     }
+    keys = paper | {k + "+informed" for k in paper}  # the informed variants: their own runs
     assert set(children["tags.planner"]) == keys
     assert children["metrics.optimal/random/success_rate"].notna().all()
 

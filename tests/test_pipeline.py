@@ -143,7 +143,7 @@ def test_smoke_dvc_repro_end_to_end(workdir):
         if r.data.tags.get("kind") == "evaluation" and "mlflow.parentRunId" not in r.data.tags
     ]
     children = [r for r in runs if r.data.tags.get("mlflow.parentRunId") == parents[0].info.run_id]
-    assert len(parents) == 1 and len(children) == 6
+    assert len(parents) == 1 and len(children) == 12  # 6 configurations, each also informed
     train_ids = {r.info.run_id for r in runs if r.data.tags.get("kind") == "vertexnet"}
     assert parents[0].data.tags["training_run.vertexnet"] in train_ids
     assert all(c.data.metrics["optimal/random/success_rate"] >= 0 for c in children)

@@ -25,8 +25,15 @@ STOP_NAMES = {
 }
 
 
+INFORMED = "+informed"
+
+
 def display_name(key: str) -> str:
-    """``m_vnrrt_star@0.5`` -> ``M-VNRRT* τ=0.5``; a heatmap source suffix ``[src]`` is kept."""
+    """``m_vnrrt_star@0.5`` -> ``M-VNRRT* τ=0.5``; a heatmap source suffix ``[src]`` is kept;
+    ``+informed`` -> ``informed ...`` (``rrt_star+informed`` -> ``Informed RRT*``)."""
+    if key.endswith(INFORMED):
+        name = display_name(key.removesuffix(INFORMED))
+        return "Informed RRT*" if name == "RRT*" else f"informed {name}"
     base, _, source = key.partition("[")
     planner, _, tau = base.partition("@")
     name = PLANNER_NAMES.get(planner, planner) + (f" τ={tau}" if tau else "")
@@ -37,10 +44,11 @@ def sort_keys(keys) -> list[str]:
     """Configuration keys in the paper's order (planner, then tau, then source)."""
 
     def rank(key: str):
-        base, _, source = key.partition("[")
+        informed = key.endswith(INFORMED)
+        base, _, source = key.removesuffix(INFORMED).partition("[")
         planner, _, tau = base.partition("@")
         order = PLANNER_ORDER.index(planner) if planner in PLANNER_ORDER else len(PLANNER_ORDER)
-        return (order, float(tau) if tau else -1.0, source)
+        return (informed, order, float(tau) if tau else -1.0, source)
 
     return sorted(keys, key=rank)
 

@@ -12,7 +12,7 @@ import numpy as np
 import pandas as pd
 import yaml
 
-from vnrrt.evaluation.protocol import STOPS
+from vnrrt.evaluation.protocol import INFORMED, STOPS
 from vnrrt.evaluation.stats import Summary, bonferroni_level, compare, summarize, verdict
 from vnrrt.evaluation.table import CONVERGENCE_COLUMNS, CONVERGENCE_FACTORS
 
@@ -128,6 +128,36 @@ def convergence_curves(table: pd.DataFrame, eps: float) -> pd.DataFrame:
     return pd.DataFrame(rows, columns=["stop", "planner", "map_set", "factor", "median_time"])
 
 
+def informed_comparisons(table: pd.DataFrame, n_boot: int = 2000, level: float = 0.95) -> dict:
+    """``{stop: {key: {metric: {"vs_informed_rrt": ..., "vs_uninformed": ...}}}}``: each
+    informed configuration on the random instances against Informed RRT* (does the learned
+    sampler help on top of informed sampling?) and against itself without informed sampling
+    (what informed sampling adds). Paired comparisons (:func:`compare`)."""
+    out: dict = {}
+    rand = table[table["map_set"] == "random"]
+    base_key = "rrt_star" + INFORMED
+    for stop, sub in rand.groupby("stop", sort=False):
+        keys = [k for k in dict.fromkeys(sub["key"]) if k.endswith(INFORMED)]
+        base = sub[sub["key"] == base_key]
+        for key in keys:
+            plan = sub[sub["key"] == key]
+            plain = sub[sub["key"] == key.removesuffix(INFORMED)]
+            cell = {}
+            for m in ("time_to_stop", "iterations"):
+                vs = {}
+                if key != base_key and not base.empty:
+                    vs["vs_informed_rrt"] = compare(
+                        base, plan, m, n_boot=n_boot, level=level
+                    ).as_dict()
+                if not plain.empty:
+                    vs["vs_uninformed"] = compare(
+                        plain, plan, m, n_boot=n_boot, level=level
+                    ).as_dict()
+                cell[m] = vs
+            out.setdefault(stop, {})[key] = cell
+    return out
+
+
 def analyze(
     table: pd.DataFrame, paper: dict, eps: float, n_boot: int = 2000, level: float = 0.95
 ) -> dict:
@@ -148,6 +178,7 @@ def analyze(
             for m in ("time_to_stop", "iterations")
         },
         "claims": claims(table, paper, n_boot, level),
+        "informed": informed_comparisons(table, n_boot, level),
         "setup_ms": {
             k: float(1e3 * sub["setup_time"].median())
             for k, sub in table.groupby("key", sort=False)

@@ -24,6 +24,7 @@ class EvalConfig:
     random_optimal: int = 1
     any_angle: bool = True  # also the optimal_any_angle stop rule (exact optimum)
     parts: list[int] = field(default_factory=lambda: [0])  # trial parts: [0, 1, ..., K-1]
+    informed: bool = True  # also every configuration with informed sampling (random maps)
 
     def validate(self) -> None:
         """Raise :class:`ConfigError` naming the first invalid value."""

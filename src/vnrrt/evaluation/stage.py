@@ -113,7 +113,7 @@ def series_per_map_set(curves) -> dict:
     (display name), median_time_ms and cost_ratio (template ``.dvc/plots/series.json``)."""
     from vnrrt.names import display_name
 
-    opt = curves[curves["stop"] == "optimal"]
+    opt = curves[(curves["stop"] == "optimal") & ~curves["planner"].str.endswith("+informed")]
     out = {}
     for map_set, sub in opt.groupby("map_set", sort=False):
         frame = sub.assign(

@@ -20,8 +20,8 @@ import time
 import numpy as np
 
 from vnrrt.grid import GridError, as_occupancy, as_point
-from vnrrt.planners import core
-from vnrrt.planners.collision import point_free, polyline_length
+from vnrrt.planners import core, spatial
+from vnrrt.planners.collision import point_free, polyline_length, segment_free
 from vnrrt.planners.config import PLANNERS, PlannerConfig
 from vnrrt.planners.reference import reference_length as compute_reference
 from vnrrt.planners.result import Milestone, PlanResult
@@ -86,19 +86,24 @@ def _check_endpoint(occ: np.ndarray, point, name: str) -> tuple[float, float]:
     return x, y
 
 
-def _params(cfg: PlannerConfig, occ: np.ndarray, goal, mix: float) -> np.ndarray:
-    params = np.zeros(8)
+def _params(cfg: PlannerConfig, occ: np.ndarray, start, goal) -> core.Params:
+    """The core's settings of a run (:class:`vnrrt.planners.core.Params`)."""
     gamma = cfg.gamma
     if gamma is None:  # RRT* bound 2 (1 + 1/d)^(1/d) (free area / unit-ball area)^(1/d), d=2
         gamma = 2.0 * math.sqrt(1.5) * math.sqrt(np.count_nonzero(occ == 0) / math.pi)
-    params[core.P_ETA] = cfg.eta
-    params[core.P_GAMMA] = gamma if cfg.radius_mode == "shrinking" else 0.0
-    params[core.P_RADIUS] = cfg.fixed_radius
-    params[core.P_GOAL_RADIUS] = cfg.eta if cfg.goal_radius is None else cfg.goal_radius
-    params[core.P_GX], params[core.P_GY] = goal
-    params[core.P_MIX] = mix
-    params[core.P_MIN_SPACING] = cfg.min_spacing
-    return params
+    return core.Params(
+        eta=float(cfg.eta),
+        gamma=float(gamma) if cfg.radius_mode == "shrinking" else 0.0,
+        radius=float(cfg.fixed_radius),
+        goal_radius=float(cfg.eta if cfg.goal_radius is None else cfg.goal_radius),
+        sx=float(start[0]),
+        sy=float(start[1]),
+        gx=float(goal[0]),
+        gy=float(goal[1]),
+        min_spacing=float(cfg.min_spacing),
+        bucket=max(cfg.eta / 2, 1.0),
+        informed=bool(cfg.informed),
+    )
 
 
 def plan(
@@ -174,72 +179,101 @@ def plan(
     return result
 
 
+class _Run:
+    """The state of one run: tree, scratch buffers, counters and trace (:mod:`.core`)."""
+
+    def __init__(self, capacity: int, shape: tuple[int, int], bucket: float, trace: int):
+        self.tree = core.new_tree(capacity, shape, bucket)
+        self.scratch = core.new_scratch(capacity)
+        self.counters = core.new_counters()
+        self.trace = core.Trace(np.empty(trace, np.int64), np.empty(trace))
+
+    def enlarge(self, capacity: int) -> None:
+        """Room for ``capacity`` nodes, the tree kept."""
+        self.tree = core.enlarge(self.tree, capacity)
+        self.scratch = core.new_scratch(capacity)
+
+    @property
+    def capacity(self) -> int:
+        return len(self.tree.cost)
+
+
 def _timed(occ, start, goal, planner, sampler, target, milestones, seed, cfg, keep_tree):
-    """The timed part of :func:`plan` on validated inputs; ``target`` None = first solution."""
+    """Plan on validated inputs; ``target`` None = first solution. The seed's generator, the
+    core's settings and the stop bounds are set up first; the timed region is the run."""
     bounds = tuple(float(m) for m in milestones)
-    t0 = time.perf_counter()
-    capacity = min(cfg.max_iterations + 2, FIRST_CAPACITY)
-    tree = core.Tree(capacity, occ.shape, max(cfg.eta / 2, 1.0), cfg.trace_capacity)
     wanted = {math.inf, *bounds, *([] if target is None else [target])}
     stops = np.array(sorted(wanted, reverse=True))
-    reason, times, iters = _drive(tree, occ, sampler, start, goal, stops, target, seed, cfg, t0)
+    rng = rng_state(seed)
+    p = _params(cfg, occ, start, goal)
+    cdf = sampler.cdf if sampler.cdf.size else np.zeros(1)
+    draws = core.Draws(float(sampler.mix), cdf, max(sampler.last, 0))
+    t0 = time.perf_counter()
+    straight = cfg.straight_first and segment_free(occ, p.sx, p.sy, p.gx, p.gy)
+    capacity = 2 if straight else min(cfg.max_iterations + 2, FIRST_CAPACITY)  # root and goal
+    run = _Run(capacity, occ.shape, p.bucket, cfg.trace_capacity)
+    reason, times, iters = _drive(run, occ, draws, p, rng, stops, target, cfg, t0)
     elapsed = time.perf_counter() - t0
     reached = {b: (float(t), int(i)) for b, t, i in zip(stops, times, iters, strict=True)}
-    result = _result(tree, planner, reason, reached, elapsed, keep_tree)
+    result = _result(run, planner, reason, reached, elapsed, keep_tree)
     extra = tuple(Milestone(b, *reached[b]) for b in bounds)
     return dataclasses.replace(
         result, target_cost=target, milestones=extra, fallback_uniform=sampler.fallback_uniform
     )
 
 
-def _drive(tree, occ, sampler, start, goal, stops, target, seed, cfg, t0):
-    """Grow ``tree`` in compiled chunks until the stop rule or a budget is met.
+def _start(run: _Run, occ, p: core.Params, stops, straight_first: bool) -> None:
+    """The root at the start; the goal joins it when it is within reach and visible (any
+    distance with ``straight_first``: a free straight segment is the optimum)."""
+    tree, c = run.tree, run.counters
+    core.add_node(tree, 0, -1, p.sx, p.sy, 0.0)
+    spatial.insert(tree.head, tree.bnext, p.bucket, 0, p.sx, p.sy)
+    c.nodes[0] = 1
+    first = p._replace(goal_radius=math.inf) if straight_first else p
+    core.connect_goal(occ, tree, c, run.scratch.stack, first, 0)
+    core.record(c, tree, run.trace, stops)
+
+
+def _drive(run, occ, draws, p, rng, stops, target, cfg, t0):
+    """Grow the tree in compiled chunks until the stop rule or a budget is met.
 
     Returns ``(stop_reason, times, iterations)``: per entry of ``stops`` (decreasing cost
     bounds), the time (s since ``t0``) and iteration at which it was first reached.
     """
-    rng = rng_state(seed)
-    params = _params(cfg, occ, goal, sampler.mix)
-    cdf = sampler.cdf if sampler.cdf.size else np.zeros(1)
-    sampler_args = (cdf, max(sampler.last, 0))
-    c = tree.counters
-    tree.add_root(*start)
-    args = (occ, tree.pts, tree.cost, tree.links, c, tree.stack, 0, *goal)
-    core.connect_goal(*args, params[core.P_GOAL_RADIUS])  # the start may see the goal
-    core.record(c, tree.cost, tree.trace_it, tree.trace_cost, stops)
+    c = run.counters
+    _start(run, occ, p, stops, cfg.straight_first)
     times, iters = np.full(len(stops), math.nan), np.full(len(stops), -1, np.int64)
     stop_bound = math.inf if target is None else target
     chunk, passed, status = FIRST_CHUNK, 0, core.RUNNING
     while True:
         now = time.perf_counter() - t0
-        times[passed : c[core.MILESTONE]] = now
-        iters[passed : c[core.MILESTONE]] = c[core.ITERS]
-        passed = c[core.MILESTONE]
-        if c[core.GOAL] >= 0 and tree.cost[c[core.GOAL]] <= stop_bound:
+        times[passed : c.milestone[0]] = now
+        iters[passed : c.milestone[0]] = c.iters[0]
+        passed = c.milestone[0]
+        if c.goal[0] >= 0 and run.tree.cost[c.goal[0]] <= stop_bound:
             return "solved", times, iters
         if status == core.TREE_FULL:
-            if tree.capacity >= cfg.max_iterations + 2:
+            if run.capacity >= cfg.max_iterations + 2:
                 return "tree_full", times, iters
-            tree.grow(min(2 * tree.capacity, cfg.max_iterations + 2))
-            status = core.RUNNING
-        if c[core.ITERS] >= cfg.max_iterations:
+            run.enlarge(min(2 * run.capacity, cfg.max_iterations + 2))
+        if c.iters[0] >= cfg.max_iterations:
             return "max_iterations", times, iters
         if now >= cfg.max_seconds:
             return "max_seconds", times, iters
-        n = min(chunk, cfg.max_iterations - c[core.ITERS])
-        status = core.run_chunk(tree, occ, sampler_args, rng, stops, params, n)
+        n = min(chunk, cfg.max_iterations - int(c.iters[0]))
+        status = core.grow(occ, run.tree, run.scratch, c, run.trace, rng, draws, stops, p, n)
         chunk = min(2 * chunk, MAX_CHUNK)
 
 
-def _result(tree, planner, reason, reached, elapsed, keep_tree) -> PlanResult:
-    """Assemble a :class:`PlanResult` from a finished tree (stop-rule fields left empty)."""
-    c = tree.counters
-    n, g, k = int(c[core.N_NODES]), int(c[core.GOAL]), int(c[core.TRACE_LEN])
+def _result(run: _Run, planner, reason, reached, elapsed, keep_tree) -> PlanResult:
+    """Assemble a :class:`PlanResult` from a finished run (stop-rule fields left empty)."""
+    c, tree = run.counters, run.tree
+    n, g, k = int(c.nodes[0]), int(c.goal[0]), int(c.trace_len[0])
     path = core.branch(tree.links, tree.pts, g) if g >= 0 else np.zeros((0, 2))
     cost = polyline_length(path) if g >= 0 else math.inf
-    trace_it, trace_cost = tree.trace_it[:k].copy(), tree.trace_cost[:k].copy()
+    trace_it, trace_cost = run.trace.iters[:k].copy(), run.trace.costs[:k].copy()
     if k and trace_cost[-1] != tree.cost[g]:
-        trace_it = np.append(trace_it, c[core.ITERS])
+        trace_it = np.append(trace_it, c.iters[0])
         trace_cost = np.append(trace_cost, tree.cost[g])
     first_time, first_iter = reached[math.inf]
     return PlanResult(
@@ -248,9 +282,9 @@ def _result(tree, planner, reason, reached, elapsed, keep_tree) -> PlanResult:
         stop_reason=reason,
         path=path,
         cost=cost,
-        iterations=int(c[core.ITERS]),
+        iterations=int(c.iters[0]),
         tree_size=n,
-        collision_checks=int(c[core.CHECKS]),
+        collision_checks=int(c.checks[0]),
         time_to_first=first_time,
         time_to_stop=elapsed,
         first_cost=float(trace_cost[0]) if k else math.inf,
@@ -272,5 +306,7 @@ def warmup() -> None:
     heat = np.ones((8, 8))
     for planner, hm in (("rrt_star", None), ("vnrrt_star", heat)):
         sampler = make_sampler(planner, occ.shape, hm)
-        _timed(occ, (1.5, 3.5), (6.5, 3.5), planner, sampler, 0.0, (), 0, cfg, False)
+        for informed in (False, True):
+            c = cfg.replace(informed=informed)
+            _timed(occ, (1.5, 3.5), (6.5, 3.5), planner, sampler, 0.0, (), 0, c, False)
     log.debug("planner kernels compiled")

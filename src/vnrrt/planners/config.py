@@ -32,7 +32,8 @@ class PlannerConfig:
             ``2 sqrt(1.5) sqrt(free area / pi)`` of the map (Karaman and Frazzoli).
         fixed_radius: near radius in ``'fixed'`` mode (pixels).
         goal_radius: a node within this distance connects to the goal point by a
-            collision-free straight segment; ``None`` means ``eta``.
+            collision-free straight segment; ``None`` means ``eta``; ``.inf``: any node
+            that sees the goal.
         mix: probability of a heatmap draw in NRRT*/VNRRT*/M-VNRRT* (Algorithm 2: 0.5).
         tau: default mask threshold of M-VNRRT* when ``plan`` gets none.
         taus: thresholds evaluated for M-VNRRT* (paper: 0.5, 0.9, 0.99).
@@ -44,6 +45,12 @@ class PlannerConfig:
             node (the iteration counts). Without it, a concentrated heatmap (M-VNRRT*)
             draws many samples inside the same few pixels, RRT* piles nodes up there and
             every near search and rewire grows with the pile; 0 disables it.
+        informed: Informed RRT* (Gammell et al. 2014): once a solution of cost c exists,
+            sample (uniform and heatmap draws) inside the ellipse with foci start and goal
+            and major axis c, and skip nodes that cannot improve the solution
+            (:mod:`vnrrt.planners.core`). Off in the paper's protocol.
+        straight_first: try the straight start-goal segment first (any length): when it is
+            free it is the optimum and the run ends at once. Off in the paper's protocol.
         max_iterations, max_seconds: budgets; hitting one is a recorded failure.
         trace_capacity: most points kept in the sparse cost-versus-iteration trace.
     """
@@ -59,6 +66,8 @@ class PlannerConfig:
     eps: float = 0.01
     reference: str = "astar"
     min_spacing: float = 0.5
+    informed: bool = False
+    straight_first: bool = False
     max_iterations: int = 200_000
     max_seconds: float = 30.0
     trace_capacity: int = 1024
@@ -68,9 +77,15 @@ class PlannerConfig:
         for name in ("eta", "fixed_radius", "max_seconds"):
             v = getattr(self, name)
             self._check(name, _finite(v) and v > 0, "> 0")
-        for name in ("gamma", "goal_radius"):
-            v = getattr(self, name)
-            self._check(name, v is None or (_finite(v) and v > 0), "null or > 0")
+        self._check(
+            "gamma", self.gamma is None or (_finite(self.gamma) and self.gamma > 0), "null or > 0"
+        )
+        g = self.goal_radius
+        self._check(
+            "goal_radius", g is None or g == math.inf or (_finite(g) and g > 0), "null, > 0 or .inf"
+        )
+        for name in ("informed", "straight_first"):
+            self._check(name, isinstance(getattr(self, name), bool), "true or false")
         self._check("radius_mode", self.radius_mode in RADIUS_MODES, f"one of {RADIUS_MODES}")
         self._check("reference", self.reference in REFERENCES, f"one of {REFERENCES}")
         self._check("mix", _finite(self.mix) and 0.0 <= self.mix <= 1.0, "in [0, 1]")

@@ -69,7 +69,7 @@ def improvements_figure(per_key: dict, stop: str, baseline: str = "RRT*"):
     """Fig. 5: improvement over ``baseline`` in % (paired speed-up - 1) per map set, one bar
     per configuration in the paper's order, whiskers = the CI. ``per_key``: ``{key:
     {map_set: {"speedup", "ci_low", "ci_high"}}}``. Returns the figure."""
-    keys = sort_keys(per_key)
+    keys = sort_keys(k for k in per_key if not k.endswith("+informed"))
     sets = [
         m
         for m in ("map_1", "map_2", "map_3", "map_4", "map_5", "random")
@@ -133,7 +133,7 @@ def convergence_figure(curves, names: dict[str, str] | None = None):
         for c, map_set in enumerate(sets):
             ax = axes[r, c]
             sub = curves[(curves["stop"] == stop) & (curves["map_set"] == map_set)]
-            for key in sort_keys(set(sub["planner"])):
+            for key in sort_keys(k for k in set(sub["planner"]) if not k.endswith("+informed")):
                 rows = sub[sub["planner"] == key].sort_values("factor", ascending=False)
                 (line,) = ax.plot(rows["median_time"] * 1e3, rows["factor"], "o-", ms=3)
                 handles.setdefault(display_name(key), line)

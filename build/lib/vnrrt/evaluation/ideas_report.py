@@ -97,6 +97,14 @@ def conclusion(summary: dict) -> list[str]:
                 f"points (vertex oracle, VNRRT*: {_x(v)} over RRT*) needs {word} sampling "
                 f"near the whole path (path oracle, NRRT*: {_x(p)})."
             )
+        taut_p = per.get("nrrt_star[oracle_taut_path]")
+        taut_v = per.get("vnrrt_star[oracle_taut_vertex]")
+        if taut_p and taut_v and "iterations" in taut_p and "iterations" in taut_v:
+            out.append(
+                f"Read most favourably, with the exact optimum's own segments and turning "
+                f"points ({STOP_NAMES[stop]}): near the path {_x(taut_p['iterations'])}, near "
+                f"the turning points {_x(taut_v['iterations'])} fewer iterations than RRT*."
+            )
         masked = {
             k: c
             for k, c in per.items()

@@ -18,7 +18,9 @@ from vnrrt.io import read_json
 
 def metric_name(*parts: str) -> str:
     """An MLflow metric name from parts (``@`` is not allowed in names: ``_tau``)."""
-    return "/".join(p.replace("@", "_tau").replace("[", "(").replace("]", ")") for p in parts)
+    return "/".join(
+        p.replace("@", "_tau").replace("[", "(").replace("]", ")").replace("+", "_") for p in parts
+    )
 
 
 def _flat(tree: dict, prefix: tuple = ()) -> dict[str, float]:

@@ -28,6 +28,7 @@ from vnrrt.config import ConfigError
 from vnrrt.evaluation.config import PLANNERS, EvalConfig
 
 STOPS = ("initial", "optimal", "optimal_any_angle")
+INFORMED = "+informed"  # key suffix of a configuration with informed sampling
 KINDS = ("named", "random")
 # Trials of one (instance, configuration, stop) are cut into jobs of at most this many, so
 # that a process pool and the parts of ``eval.parts`` share the work evenly.
@@ -49,6 +50,7 @@ class PlannerSpec:
     tau: float | None = None
     source: str | None = None
     key: str = ""  # row key; filled from the fields when empty
+    informed: bool = False  # Informed RRT* sampling and skipping (ours, beyond the paper)
 
     def __post_init__(self) -> None:
         if self.planner not in PLANNERS:
@@ -58,21 +60,14 @@ class PlannerSpec:
         if (self.planner == "m_vnrrt_star") != (self.tau is not None):
             raise ConfigError(f"{self.planner}: M-VNRRT* and only M-VNRRT* takes tau")
         if not self.key:
-            object.__setattr__(self, "key", planner_key(self.planner, self.tau))
-
-
-def check_taus(taus: list[float], key: str = "planner.taus") -> list[float]:
-    """Mask thresholds must lie in (0, 1]: a heatmap is a probability map (max 1), so a
-    threshold above 1 masks everything and M-VNRRT* silently becomes RRT*."""
-    for t in taus:
-        if not (isinstance(t, int | float) and 0.0 < t <= 1.0):
-            raise ConfigError(f"invalid config value {key}={taus!r}: every tau must be in (0, 1]")
-    return [float(t) for t in taus]
+            suffix = INFORMED if self.informed else ""
+            object.__setattr__(self, "key", planner_key(self.planner, self.tau) + suffix)
 
 
 def planner_specs(ev: EvalConfig, taus: list[float]) -> list[PlannerSpec]:
     """The paper's configurations: every planner of ``ev.planners`` sampling its source of
-    ``ev.sources``, M-VNRRT* once per threshold in ``taus`` (sorted, unique)."""
+    ``ev.sources``, M-VNRRT* once per threshold in ``taus`` (sorted, unique); with
+    ``ev.informed`` each again with informed sampling (run on the random instances only)."""
     specs = []
     for p in ev.planners:
         if p == "rrt_star":
@@ -81,6 +76,8 @@ def planner_specs(ev: EvalConfig, taus: list[float]) -> list[PlannerSpec]:
             specs += [PlannerSpec(p, t, ev.sources[p]) for t in sorted(set(taus))]
         else:
             specs.append(PlannerSpec(p, None, ev.sources[p]))
+    if ev.informed:
+        specs += [PlannerSpec(s.planner, s.tau, s.source, informed=True) for s in list(specs)]
     return specs
 
 
@@ -108,13 +105,14 @@ def parse_key(key: str, sources: dict[str, str] | None = None) -> PlannerSpec:
     """The configuration a row key names: ``rrt_star``, ``m_vnrrt_star@0.5``, or with a
     heatmap source ``vnrrt_star[oracle_vertex]`` (a network name or an oracle); without one,
     a learned planner samples its source in ``sources`` (``eval.sources``)."""
-    base, _, source = key.partition("[")
+    informed = key.endswith(INFORMED)
+    base, _, source = key.removesuffix(INFORMED).partition("[")
     planner, _, tau = base.partition("@")
     if source and not source.endswith("]"):
-        raise ConfigError(f"bad configuration {key!r}: expected planner[@tau][[source]]")
+        raise ConfigError(f"bad configuration {key!r}: expected planner[@tau][[source]][+informed]")
     src = source[:-1] or (sources or {}).get(planner)
     try:
-        return PlannerSpec(planner, float(tau) if tau else None, src, key)
+        return PlannerSpec(planner, float(tau) if tau else None, src, key, informed)
     except ValueError as err:
         raise ConfigError(f"bad configuration {key!r}: {err}") from None
 
@@ -158,6 +156,8 @@ def trial_jobs(
             for spec in specs:
                 for stop in STOPS:
                     n = counts.get((kinds[i], stop), 0)
+                    if spec.informed and kinds[i] == "named":
+                        n = 0  # beyond the paper: the random instances only
                     for first in range(0, n, per_job):
                         count = min(per_job, n - first)
                         jobs.append(TrialJob(i, spec, stop, first, count, seq, regime))

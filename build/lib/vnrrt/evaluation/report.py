@@ -11,8 +11,8 @@ from __future__ import annotations
 
 import math
 
+from vnrrt.names import INFORMED, display_name, sort_keys
 from vnrrt.names import MAP_SET_NAMES as COLUMN_NAMES
-from vnrrt.names import display_name, sort_keys
 
 STOP_TITLES = {
     "initial": "initial solution",
@@ -51,7 +51,8 @@ def table(summary: dict, spec: dict, columns: list[str], metric: str, unit: floa
     stop = spec["stop"]
     rows = spec.get("rows", {}) if metric == spec.get("metric") else {}
     ours = summary["cells"].get(stop, {})
-    keys = list(rows) + [k for k in sort_keys(summary["keys"]) if k not in rows]
+    paper_keys = [k for k in sort_keys(summary["keys"]) if not k.endswith(INFORMED)]
+    keys = list(rows) + [k for k in paper_keys if k not in rows]
     lines = [
         "| configuration | source | " + " | ".join(COLUMN_NAMES.get(c, c) for c in columns) + " |",
         "|" + " --- |" * (len(columns) + 2),
@@ -142,6 +143,8 @@ def speedup_table(speedups: dict, stop: str, columns: list[str]) -> str:
         "|" + " --- |" * (len(columns) + 1),
     ]
     for key, sets in per_key.items():
+        if key.endswith(INFORMED):
+            continue  # their own section
         vals = []
         for c in columns:
             s = sets.get(c)
@@ -161,6 +164,8 @@ def inference_table(summary: dict, inference_ms: dict[str, float], sources: dict
     ]
     for stop in ("initial", "optimal"):
         for key, sets in summary["cells"].get(stop, {}).items():
+            if key.endswith(INFORMED):
+                continue
             s = sets.get("random", {}).get("time_to_stop")
             if s is None:
                 continue
@@ -195,6 +200,40 @@ RULES = """How to read the tables:
 - Our named maps are our own (built to the paper's difficulty ordering, not to its
   geometry, which the paper does not give), so claims on Maps 1-5 are marked "different map:
   not comparable"; the random-maps column is the comparable one."""
+
+
+def informed_section(summary: dict) -> str:
+    """Informed variants on the random instances: medians, and paired speed-ups against
+    Informed RRT* and against the same configuration without informed sampling."""
+    parts = []
+    for stop, per_key in summary.get("informed", {}).items():
+        cells = summary["cells"].get(stop, {})
+        lines = [
+            f"### {STOP_TITLES[stop]}",
+            "",
+            "| configuration | median ms | median iterations | time vs Informed RRT* | "
+            "iterations vs Informed RRT* | time vs not informed |",
+            "|" + " --- |" * 6,
+        ]
+        for key in sort_keys(per_key):
+            c = cells.get(key, {}).get("random", {})
+            t, it = c.get("time_to_stop"), c.get("iterations")
+            vs = per_key[key]
+            lines.append(
+                f"| {display_name(key)} | {_num(1e3 * t['median']) if t else '—'} | "
+                f"{_num(it['median']) if it else '—'} | "
+                f"{_speed(vs['time_to_stop'].get('vs_informed_rrt'))} | "
+                f"{_speed(vs['iterations'].get('vs_informed_rrt'))} | "
+                f"{_speed(vs['time_to_stop'].get('vs_uninformed'))} |"
+            )
+        parts += ["\n".join(lines), ""]
+    return "\n".join(parts)
+
+
+def _speed(c: dict | None) -> str:
+    if not c:
+        return "—"
+    return f"{c['speedup']:.2f}x [{c['ci_low']:.2f}, {c['ci_high']:.2f}]"
 
 
 def build_report(
@@ -264,6 +303,17 @@ def build_report(
             "",
             speedup_table(summary["over_rrt_star"]["time_to_stop"], stop, cols),
             "",
+        ]
+    if summary.get("informed"):
+        parts += [
+            "## Informed sampling: does the learned sampler help on top of it? (ours, not "
+            "in the paper)",
+            "",
+            "Every configuration again with informed sampling (Gammell et al. 2014: once a "
+            "solution exists, samples inside the ellipse of shorter paths; nodes that cannot "
+            "improve it skipped), on the random instances; paired speed-ups with 95% CIs.",
+            "",
+            informed_section(summary),
         ]
     setup = ", ".join(f"{display_name(k)} {v:.2f} ms" for k, v in summary["setup_ms"].items())
     parts += [

@@ -63,7 +63,7 @@ def headline(summary: dict, predict: dict) -> dict:
             out["mass_x_uniform"][net] = round(share / uniform, 3)
     for key, sets in summary["cells"].get("optimal", {}).items():
         s = sets.get("random", {}).get("time_to_stop")
-        if s is not None:
+        if s is not None and not key.endswith("+informed"):
             out["opt_ms"][short_key(key)] = round(1e3 * s["median"], 3)
     rows = summary["claims"]["rows"]
     verdicts = [r[m]["verdict"] for r in rows for m in ("time_to_stop", "iterations") if r[m]]

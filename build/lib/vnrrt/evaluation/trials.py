@@ -100,6 +100,8 @@ def run_job(
     ``configs`` holds the planner settings of each regime cell (``''``: the protocol's)."""
     job, inst = args
     spec, stop, config = job.spec, job.stop, configs[job.regime]
+    if spec.informed:
+        config = config.replace(informed=True)
     warmup()
     heatmap, mass = None, math.nan
     if spec.source is not None:

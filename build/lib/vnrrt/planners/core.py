@@ -1,89 +1,147 @@
 """The one RRT* core (paper, Algorithm 1 / Algorithm 2), compiled with numba.
 
-All planners (RRT*, NRRT*, VNRRT*, M-VNRRT*) run :func:`grow`; they differ only in the
-:class:`~vnrrt.planners.samplers.Sampler` data passed in and in their stop rule. One
-iteration is: Sample, Nearest, Steer (step ``eta``), ObstacleFree, Extend (choose the
-cheapest collision-free parent among the near nodes), Rewire (re-parent near nodes
-through the new node, propagating the cost change to their descendants), then try to
-connect the new node to the goal point.
+All planners (RRT*, NRRT*, VNRRT*, M-VNRRT*, and their informed variants) run :func:`grow`;
+they differ only in the :class:`Draws` (the sampler) and :class:`Params` passed in and in
+their stop rule. One iteration is: Sample, Nearest, Steer (step ``eta``), ObstacleFree,
+Extend (choose the cheapest collision-free parent among the near nodes), Rewire (re-parent
+near nodes through the new node, propagating the cost change to their descendants), then
+try to connect the new node to the goal point.
 
-The tree lives in preallocated arrays (:class:`Tree`); positions are continuous
-``(x, y)`` pixels, costs are path lengths in pixels from the start. The goal, once
-connected, is a leaf node that is never a Nearest/near candidate, so its cost is the
-best solution cost and improves through re-parenting and cost propagation.
+**Informed** (Gammell et al., 2014), when ``Params.informed``: once a solution of cost
+``c_best`` exists, samples come from the ellipse with foci start and goal and major axis
+``c_best`` (:func:`vnrrt.planners.samplers.informed_point`), and nodes that cannot improve
+the solution are skipped: a near node ``q`` with ``|q - start| + |q - goal| > c_best`` is no
+parent or rewiring candidate, and a new node whose cost-to-come plus its straight line to the
+goal exceeds ``c_best`` is not added (no path through it can be better).
+
+The tree lives in preallocated arrays (:class:`Tree`); positions are continuous ``(x, y)``
+pixels, costs are path lengths in pixels from the start. The goal, once connected, is a
+leaf node that is never a Nearest/near candidate, so its cost is the best solution cost
+and improves through re-parenting and cost propagation.
 """
 
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
 
 from vnrrt.planners import spatial
 from vnrrt.planners.collision import segment_free
-from vnrrt.planners.samplers import sample_point
+from vnrrt.planners.samplers import informed_point, sample_point
 
-PARENT, CHILD, NEXT, PREV = 0, 1, 2, 3  # columns of ``links``: tree as linked lists
-N_NODES, ITERS, CHECKS, GOAL, TRACE_LEN, MILESTONE = range(6)  # slots of ``counters``
+PARENT, CHILD, NEXT, PREV = 0, 1, 2, 3  # columns of ``Tree.links``: the tree as linked lists
 RUNNING, MILESTONE_HIT, TREE_FULL = 0, 1, 2  # return codes of :func:`grow`
 TRACE_REL = 1e-4  # relative improvement that earns a new trace point
 
 
-class Tree:
-    """Preallocated state of one RRT* run for at most ``capacity`` nodes.
+class Tree(NamedTuple):
+    """The nodes of one RRT* run, capacity ``C``: ``pts`` (C, 2) float64 positions (x, y),
+    ``cost`` (C,) cost-to-come, ``links`` (C, 4) int64 parent / first child / next and
+    previous sibling (-1: none), ``bnext`` (C,) and ``head`` the bucket grid
+    (:mod:`.spatial`)."""
 
-    Arrays: ``pts`` (C, 2) float64 node positions (x, y); ``cost`` (C,) float64 cost-to-come;
-    ``links`` (C, 4) int64 parent / first child / next and previous sibling (-1: none);
-    ``bnext`` (C,) int64 bucket lists; ``head`` bucket heads (see :mod:`.spatial`);
-    ``counters`` (6,) int64; ``trace_it``/``trace_cost`` (T,) the sparse cost trace;
-    scratch buffers for near sets and subtree walks.
-    """
+    pts: np.ndarray
+    cost: np.ndarray
+    links: np.ndarray
+    bnext: np.ndarray
+    head: np.ndarray
 
-    def __init__(self, capacity: int, shape: tuple[int, int], bucket: float, trace: int):
-        c = int(capacity)
-        self.pts = np.empty((c, 2))
-        self.cost = np.empty(c)
-        self.links = np.empty((c, 4), np.int64)
-        self.bnext = np.empty(c, np.int64)
-        self.head = spatial.new_buckets(shape, bucket)
-        self.bucket = float(bucket)
-        self.counters = np.zeros(6, np.int64)
-        self.counters[GOAL] = -1
-        self.trace_it = np.empty(trace, np.int64)
-        self.trace_cost = np.empty(trace)
-        self.near_idx = np.empty(c, np.int64)
-        self.near_d = np.empty(c)
-        self.near_c = np.empty(c)
-        self.near_ok = np.empty(c, np.int8)
-        self.stack = np.empty(c, np.int64)
 
-    def grow(self, capacity: int) -> None:
-        """Enlarge the arrays to ``capacity`` nodes, keeping the tree (memory grows with the
-        work done, not with the iteration budget)."""
-        c, n = int(capacity), len(self.cost)
-        if c <= n:
-            return
-        for name in ("pts", "cost", "links", "bnext"):
-            old = getattr(self, name)
-            new = np.empty((c, *old.shape[1:]), old.dtype)
-            new[:n] = old
-            setattr(self, name, new)
-        self.near_idx = np.empty(c, np.int64)
-        self.near_d = np.empty(c)
-        self.near_c = np.empty(c)
-        self.near_ok = np.empty(c, np.int8)
-        self.stack = np.empty(c, np.int64)
+class Scratch(NamedTuple):
+    """Buffers of one iteration: the near set (indices, distances, costs through them,
+    segment checks 0 unknown / 1 free / 2 blocked) and a stack for subtree walks."""
 
-    @property
-    def capacity(self) -> int:
-        return len(self.cost)
+    near_idx: np.ndarray
+    near_d: np.ndarray
+    near_c: np.ndarray
+    near_ok: np.ndarray
+    stack: np.ndarray
 
-    def add_root(self, x: float, y: float) -> None:
-        """Insert the start node (index 0, cost 0)."""
-        add_node(self.pts, self.cost, self.links, 0, -1, x, y, 0.0)
-        spatial.insert(self.head, self.bnext, self.bucket, 0, x, y)
-        self.counters[N_NODES] = 1
+
+class Counters(NamedTuple):
+    """Mutable counts, each a (1,) int64 array: nodes in the tree, iterations (samples),
+    segment checks, the goal node (-1: none yet), trace points, milestones passed."""
+
+    nodes: np.ndarray
+    iters: np.ndarray
+    checks: np.ndarray
+    goal: np.ndarray
+    trace_len: np.ndarray
+    milestone: np.ndarray
+
+
+class Trace(NamedTuple):
+    """The sparse best-cost trace: ``iters`` (T,) int64 and ``costs`` (T,) float64."""
+
+    iters: np.ndarray
+    costs: np.ndarray
+
+
+class Params(NamedTuple):
+    """Settings of a run (lengths in pixels): Steer step, near-radius rule (``gamma > 0``:
+    shrinking ``min(gamma sqrt(log n / n), eta)``, else ``radius``), goal connection
+    radius (``inf``: any node that sees the goal), start and goal, min spacing, bucket
+    side, informed sampling and skipping."""
+
+    eta: float
+    gamma: float
+    radius: float
+    goal_radius: float
+    sx: float
+    sy: float
+    gx: float
+    gy: float
+    min_spacing: float
+    bucket: float
+    informed: bool
+
+
+class Draws(NamedTuple):
+    """The sampler: heatmap draw probability ``mix``, cumulative weights ``cdf`` over flat
+    pixels and the last pixel with weight (see :mod:`.samplers`)."""
+
+    mix: float
+    cdf: np.ndarray
+    last: int
+
+
+def new_tree(capacity: int, shape: tuple[int, int], bucket: float) -> Tree:
+    """Empty node arrays for ``capacity`` nodes on an ``(H, W)`` map."""
+    c = int(capacity)
+    return Tree(
+        np.empty((c, 2)),
+        np.empty(c),
+        np.empty((c, 4), np.int64),
+        np.empty(c, np.int64),
+        spatial.new_buckets(shape, bucket),
+    )
+
+
+def new_scratch(capacity: int) -> Scratch:
+    c = int(capacity)
+    return Scratch(
+        np.empty(c, np.int64), np.empty(c), np.empty(c), np.empty(c, np.int8), np.empty(c, np.int64)
+    )
+
+
+def new_counters() -> Counters:
+    c = Counters(*(np.zeros(1, np.int64) for _ in Counters._fields))
+    c.goal[0] = -1
+    return c
+
+
+def enlarge(tree: Tree, capacity: int) -> Tree:
+    """The same tree in arrays for ``capacity`` nodes (memory grows with the work done)."""
+    n = len(tree.cost)
+    out = []
+    for arr in tree[:4]:
+        new = np.empty((int(capacity), *arr.shape[1:]), arr.dtype)
+        new[:n] = arr
+        out.append(new)
+    return Tree(*out, tree.head)
 
 
 @njit(cache=True)
@@ -100,16 +158,17 @@ def _link(links, i, parent):
 
 
 @njit(cache=True)
-def add_node(pts, cost, links, i, parent, x, y, c):
+def add_node(tree, i, parent, x, y, c):
     """Write node ``i`` at ``(x, y)`` with cost ``c`` as a new leaf under ``parent``."""
-    pts[i, 0], pts[i, 1], cost[i] = x, y, c
-    links[i, CHILD] = -1
-    _link(links, i, parent)
+    tree.pts[i, 0], tree.pts[i, 1], tree.cost[i] = x, y, c
+    tree.links[i, CHILD] = -1
+    _link(tree.links, i, parent)
 
 
 @njit(cache=True)
-def reparent(cost, links, stack, i, parent, c):
+def reparent(tree, stack, i, parent, c):
     """Move node ``i`` under ``parent`` with new cost ``c``; shift its subtree's costs."""
+    links, cost = tree.links, tree.cost
     prev, nxt = links[i, PREV], links[i, NEXT]
     if prev >= 0:
         links[prev, NEXT] = nxt
@@ -132,162 +191,174 @@ def reparent(cost, links, stack, i, parent, c):
             child = links[child, NEXT]
 
 
-@njit(cache=True)
-def choose_parent(occ, pts, cost, counters, near_idx, near_d, near_c, near_ok, k, x, y, p0, c0):
-    """Extend: cheapest collision-free parent for a new node at ``(x, y)``.
+@njit(cache=True, inline="always")
+def best_cost(tree, counters):
+    """Cost of the best solution so far (``inf`` before the first)."""
+    g = counters.goal[0]
+    return tree.cost[g] if g >= 0 else np.inf
 
-    Candidates are the ``k`` near nodes, tried in order of cost-through-them; ``p0``
-    (the nearest node, already checked) with cost ``c0`` is the default. Segment checks
-    are cached in ``near_ok`` (0 unknown, 1 free, 2 blocked) for :func:`rewire`.
-    """
+
+@njit(cache=True, inline="always")
+def hopeless(p, x, y, c_best):
+    """True when no path through ``(x, y)`` can beat ``c_best`` (informed skipping)."""
+    return p.informed and math.hypot(x - p.sx, y - p.sy) + math.hypot(x - p.gx, y - p.gy) > c_best
+
+
+@njit(cache=True)
+def choose_parent(occ, tree, scratch, counters, p, k, x, y, p0, c0, c_best):
+    """Extend: cheapest collision-free parent for a new node at ``(x, y)`` among the ``k``
+    near nodes, tried in order of cost-through-them; ``p0`` (the nearest node, already
+    checked) with cost ``c0`` is the default. Segment checks are cached in
+    ``scratch.near_ok`` for :func:`rewire`."""
+    s = scratch
     for j in range(k):
-        near_c[j] = cost[near_idx[j]] + near_d[j]
-        near_ok[j] = 1 if near_idx[j] == p0 else 0
-    for j in np.argsort(near_c[:k]):
-        if near_c[j] >= c0:
+        q = s.near_idx[j]
+        s.near_c[j] = tree.cost[q] + s.near_d[j]
+        s.near_ok[j] = 1 if q == p0 else 0
+        if q != p0 and hopeless(p, tree.pts[q, 0], tree.pts[q, 1], c_best):
+            s.near_ok[j] = 2  # skipped: no candidate
+    for j in np.argsort(s.near_c[:k]):
+        if s.near_c[j] >= c0:
             break
-        q = near_idx[j]
-        counters[CHECKS] += 1
-        if segment_free(occ, pts[q, 0], pts[q, 1], x, y):
-            near_ok[j] = 1
-            return q, near_c[j]
-        near_ok[j] = 2
+        if s.near_ok[j] == 2:
+            continue
+        q = s.near_idx[j]
+        counters.checks[0] += 1
+        if segment_free(occ, tree.pts[q, 0], tree.pts[q, 1], x, y):
+            s.near_ok[j] = 1
+            return q, s.near_c[j]
+        s.near_ok[j] = 2
     return p0, c0
 
 
 @njit(cache=True)
-def rewire(occ, pts, cost, links, counters, stack, near_idx, near_d, near_ok, k, new):
-    """Rewire: re-parent near nodes through ``new`` when that is cheaper and free."""
+def rewire(occ, tree, scratch, counters, k, new):
+    """Rewire: re-parent near nodes through ``new`` when that is cheaper and free (nodes
+    skipped by :func:`choose_parent` stay as they are)."""
+    s = scratch
     for j in range(k):
-        q = near_idx[j]
-        c = cost[new] + near_d[j]
-        if q == links[new, PARENT] or c >= cost[q] - 1e-9:
+        q = s.near_idx[j]
+        c = tree.cost[new] + s.near_d[j]
+        if q == tree.links[new, PARENT] or c >= tree.cost[q] - 1e-9:
             continue
-        ok = near_ok[j]
+        ok = s.near_ok[j]
         if ok == 0:
-            counters[CHECKS] += 1
-            ok = 1 if segment_free(occ, pts[q, 0], pts[q, 1], pts[new, 0], pts[new, 1]) else 2
+            counters.checks[0] += 1
+            free = segment_free(
+                occ, tree.pts[q, 0], tree.pts[q, 1], tree.pts[new, 0], tree.pts[new, 1]
+            )
+            ok = 1 if free else 2
         if ok == 1:
-            reparent(cost, links, stack, q, new, c)
+            reparent(tree, s.stack, q, new, c)
 
 
 @njit(cache=True)
-def connect_goal(occ, pts, cost, links, counters, stack, new, gx, gy, goal_radius):
-    """Connect (or re-parent) the goal leaf to ``new`` when within reach, cheaper, free."""
-    d = math.hypot(gx - pts[new, 0], gy - pts[new, 1])
-    g = counters[GOAL]
-    if d > goal_radius or (g >= 0 and cost[new] + d >= cost[g] - 1e-9):
+def connect_goal(occ, tree, counters, stack, p, new):
+    """Connect (or re-parent) the goal leaf to ``new`` when within ``p.goal_radius``,
+    cheaper and free."""
+    d = math.hypot(p.gx - tree.pts[new, 0], p.gy - tree.pts[new, 1])
+    g = counters.goal[0]
+    if d > p.goal_radius or (g >= 0 and tree.cost[new] + d >= tree.cost[g] - 1e-9):
         return
-    counters[CHECKS] += 1
-    if not segment_free(occ, pts[new, 0], pts[new, 1], gx, gy):
+    counters.checks[0] += 1
+    if not segment_free(occ, tree.pts[new, 0], tree.pts[new, 1], p.gx, p.gy):
         return
     if g < 0:
-        g = counters[N_NODES]
-        add_node(pts, cost, links, g, new, gx, gy, cost[new] + d)
-        counters[GOAL] = g
-        counters[N_NODES] += 1
+        g = counters.nodes[0]
+        add_node(tree, g, new, p.gx, p.gy, tree.cost[new] + d)
+        counters.goal[0] = g
+        counters.nodes[0] += 1
     else:
-        reparent(cost, links, stack, g, new, cost[new] + d)
+        reparent(tree, stack, g, new, tree.cost[new] + d)
 
 
 @njit(cache=True)
-def record(counters, cost, trace_it, trace_cost, milestones):
+def record(counters, tree, trace, milestones):
     """Append to the sparse trace; return True when the best cost passed a milestone.
 
     ``milestones`` (M,) are cost bounds in decreasing order (``inf`` = any solution).
     """
-    g = counters[GOAL]
+    g = counters.goal[0]
     if g < 0:
         return False
-    c = cost[g]
-    n = counters[TRACE_LEN]
-    if n == 0 or c < trace_cost[n - 1] * (1.0 - TRACE_REL):
-        n = min(n, trace_it.shape[0] - 1)  # when full, the last point is overwritten
-        trace_it[n], trace_cost[n] = counters[ITERS], c
-        counters[TRACE_LEN] = n + 1
-    m = counters[MILESTONE]
+    c = tree.cost[g]
+    n = counters.trace_len[0]
+    if n == 0 or c < trace.costs[n - 1] * (1.0 - TRACE_REL):
+        n = min(n, trace.iters.shape[0] - 1)  # when full, the last point is overwritten
+        trace.iters[n], trace.costs[n] = counters.iters[0], c
+        counters.trace_len[0] = n + 1
+    m = counters.milestone[0]
     hit = False
     while m < milestones.shape[0] and c <= milestones[m]:
         m += 1
         hit = True
-    counters[MILESTONE] = m
+    counters.milestone[0] = m
     return hit
 
 
 @njit(cache=True)
-def near_radius(n, eta, gamma, fixed_radius):
-    """Near radius for a tree of ``n`` nodes: ``min(gamma sqrt(log n / n), eta)``, or
-    ``fixed_radius`` when ``gamma <= 0``."""
-    if gamma <= 0.0:
-        return fixed_radius
+def near_radius(n, p):
+    """Near radius for a tree of ``n`` nodes: ``min(gamma sqrt(log n / n), eta)``, or the
+    fixed ``radius`` when ``gamma <= 0``."""
+    if p.gamma <= 0.0:
+        return p.radius
     n = max(n, 2)
-    return min(gamma * math.sqrt(math.log(n) / n), eta)
-
-
-# Slots of the float64 ``params`` array given to :func:`grow`.
-P_ETA, P_GAMMA, P_RADIUS, P_GOAL_RADIUS, P_GX, P_GY, P_MIX, P_MIN_SPACING = range(8)
+    return min(p.gamma * math.sqrt(math.log(n) / n), p.eta)
 
 
 @njit(cache=True)
-def grow(
-    occ, pts, cost, links, bnext, head, bucket, counters, trace_it, trace_cost,
-    near_idx, near_d, near_c, near_ok, stack, rng, cdf, last, milestones, params, n_iter,
-):  # fmt: skip
-    """Run up to ``n_iter`` RRT* iterations on the tree arrays (see :class:`Tree`).
+def sample(rng, h, w, draws, p, c_best):
+    """Sample: the sampler's draw, inside the informed ellipse once a solution exists."""
+    if p.informed and c_best < np.inf:
+        return informed_point(
+            rng, h, w, draws.mix, draws.cdf, draws.last, p.sx, p.sy, p.gx, p.gy, c_best
+        )
+    return sample_point(rng, h, w, draws.mix, draws.cdf, draws.last)
+
+
+@njit(cache=True)
+def grow(occ, tree, scratch, counters, trace, rng, draws, milestones, p, n_iter):
+    """Run up to ``n_iter`` RRT* iterations (module doc) on ``tree``.
 
     Returns :data:`MILESTONE_HIT` as soon as the best cost passes a milestone (so the
     caller can time it), :data:`TREE_FULL` when no room is left for a node and the goal,
     else :data:`RUNNING`. ``occ`` is the ``(H, W)`` uint8 grid, ``rng`` the sampler state.
     """
     h, w = occ.shape
-    eta, goal_radius = params[P_ETA], params[P_GOAL_RADIUS]
     for _ in range(n_iter):
-        new = counters[N_NODES]
-        if new + 2 > pts.shape[0]:
+        new = counters.nodes[0]
+        if new + 2 > tree.pts.shape[0]:
             return TREE_FULL
-        counters[ITERS] += 1
-        sx, sy = sample_point(rng, h, w, params[P_MIX], cdf, last)
-        p = spatial.nearest(head, bnext, pts, bucket, sx, sy)
-        d = math.hypot(sx - pts[p, 0], sy - pts[p, 1])
-        if d <= params[P_MIN_SPACING]:  # a node here would duplicate its nearest node
+        counters.iters[0] += 1
+        c_best = best_cost(tree, counters)
+        sx, sy = sample(rng, h, w, draws, p, c_best)
+        near = spatial.nearest(tree.head, tree.bnext, tree.pts, p.bucket, sx, sy)
+        d = math.hypot(sx - tree.pts[near, 0], sy - tree.pts[near, 1])
+        if d <= p.min_spacing:  # a node here would duplicate its nearest node
             continue
-        t = min(1.0, eta / d)  # Steer
-        x, y = pts[p, 0] + t * (sx - pts[p, 0]), pts[p, 1] + t * (sy - pts[p, 1])
-        counters[CHECKS] += 1
-        if not segment_free(occ, pts[p, 0], pts[p, 1], x, y):
+        t = min(1.0, p.eta / d)  # Steer
+        x = tree.pts[near, 0] + t * (sx - tree.pts[near, 0])
+        y = tree.pts[near, 1] + t * (sy - tree.pts[near, 1])
+        counters.checks[0] += 1
+        if not segment_free(occ, tree.pts[near, 0], tree.pts[near, 1], x, y):
             continue
-        r = near_radius(new + 1, eta, params[P_GAMMA], params[P_RADIUS])
-        k = spatial.near(head, bnext, pts, bucket, x, y, r, near_idx, near_d)
-        q, c = choose_parent(
-            occ, pts, cost, counters, near_idx, near_d, near_c, near_ok, k, x, y, p, cost[p] + t * d
+        r = near_radius(new + 1, p)
+        k = spatial.near(
+            tree.head, tree.bnext, tree.pts, p.bucket, x, y, r, scratch.near_idx, scratch.near_d
         )
-        add_node(pts, cost, links, new, q, x, y, c)
-        spatial.insert(head, bnext, bucket, new, x, y)
-        counters[N_NODES] += 1
-        rewire(occ, pts, cost, links, counters, stack, near_idx, near_d, near_ok, k, new)
-        gx, gy = params[P_GX], params[P_GY]
-        connect_goal(occ, pts, cost, links, counters, stack, new, gx, gy, goal_radius)
-        if record(counters, cost, trace_it, trace_cost, milestones):
+        q, c = choose_parent(
+            occ, tree, scratch, counters, p, k, x, y, near, tree.cost[near] + t * d, c_best
+        )
+        if p.informed and c + math.hypot(p.gx - x, p.gy - y) >= c_best:
+            continue  # no path through this node can improve the solution
+        add_node(tree, new, q, x, y, c)
+        spatial.insert(tree.head, tree.bnext, p.bucket, new, x, y)
+        counters.nodes[0] += 1
+        rewire(occ, tree, scratch, counters, k, new)
+        connect_goal(occ, tree, counters, scratch.stack, p, new)
+        if record(counters, tree, trace, milestones):
             return MILESTONE_HIT
     return RUNNING
-
-
-def run_chunk(
-    tree: Tree,
-    occ: np.ndarray,
-    sampler_args: tuple[np.ndarray, int],
-    rng: np.ndarray,
-    milestones: np.ndarray,
-    params: np.ndarray,
-    n_iter: int,
-) -> int:
-    """Call :func:`grow` on ``tree``; ``sampler_args`` is ``(cdf, last)``."""
-    t = tree
-    arrays = (t.trace_it, t.trace_cost, t.near_idx, t.near_d, t.near_c, t.near_ok, t.stack)
-    return grow(
-        occ, t.pts, t.cost, t.links, t.bnext, t.head, t.bucket, t.counters, *arrays,
-        rng, sampler_args[0], sampler_args[1], milestones, params, int(n_iter),
-    )  # fmt: skip
 
 
 def branch(links: np.ndarray, pts: np.ndarray, node: int) -> np.ndarray:

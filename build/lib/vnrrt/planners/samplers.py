@@ -11,6 +11,10 @@ inside that pixel), otherwise uniformly from the whole map ``[0, W) x [0, H)``
   weights = the heatmap, ``mix = 0.5`` by default.
 * ``masked`` (M-VNRRT*): weights = the heatmap with values below ``tau`` set to zero.
 
+Informed sampling (:func:`informed_point`, used by the core once a solution exists when
+``informed`` is set) draws the same way but inside the ellipse of the points through which a
+shorter path can run.
+
 If no positive weight is left, the sampler falls back to uniform (``mix = 0``) and sets
 ``fallback_uniform``. Randomness comes from a xoshiro256** generator whose 4-word
 ``uint64`` state is seeded with :class:`numpy.random.SeedSequence`; no global state.
@@ -18,6 +22,7 @@ If no positive weight is left, the sampler falls back to uniform (``mix = 0``) a
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -119,27 +124,108 @@ def _below(v, hi):
     return v if v < hi else hi - 1e-9
 
 
+@njit(cache=True, inline="always")
+def _heat_point(s, w, cdf, last):
+    """A pixel drawn with probability proportional to its weight, then a uniform point in it."""
+    u = next_double(s) * cdf[last]
+    i = min(np.searchsorted(cdf, u, side="right"), last)
+    px, py = float(i % w), float(i // w)
+    return _below(px + next_double(s), px + 1.0), _below(py + next_double(s), py + 1.0)
+
+
 @njit(cache=True)
 def sample_point(s, h, w, mix, cdf, last):
     """One sample ``(x, y)`` in pixels (see module doc); ``s`` is the rng state."""
     if mix > 0.0 and next_double(s) < mix:
-        u = next_double(s) * cdf[last]
-        i = min(np.searchsorted(cdf, u, side="right"), last)
-        px, py = float(i % w), float(i // w)
-        return _below(px + next_double(s), px + 1.0), _below(py + next_double(s), py + 1.0)
+        return _heat_point(s, w, cdf, last)
     return _below(next_double(s) * w, float(w)), _below(next_double(s) * h, float(h))
 
 
+INFORMED_TRIES = 64  # uniform draws until one lies in both the ellipse and the map
+HEATMAP_TRIES = 16  # heatmap draws until one lies in the ellipse
+
+
+@njit(cache=True, inline="always")
+def in_ellipse(x, y, sx, sy, gx, gy, c_best):
+    """True when ``(x, y)`` lies in the ellipse with foci start and goal, major axis
+    ``c_best``: the points through which a path can be shorter than ``c_best``."""
+    return math.hypot(x - sx, y - sy) + math.hypot(x - gx, y - gy) <= c_best
+
+
 @njit(cache=True)
-def _draw(s, n, h, w, mix, cdf, last):
+def ellipse_uniform(s, h, w, sx, sy, gx, gy, c_best):
+    """A uniform point of the ellipse (foci start and goal, major axis ``c_best``) inside the
+    map ``[0, W) x [0, H)``, by rejection: from the ellipse when it is smaller than the map,
+    else from the map. After :data:`INFORMED_TRIES` rejections the last map point is kept
+    (the ellipse then covers next to none of the map; never seen in practice)."""
+    c_min = math.hypot(gx - sx, gy - sy)
+    a = 0.5 * c_best
+    b = 0.5 * math.sqrt(max(c_best * c_best - c_min * c_min, 0.0))
+    cos_t, sin_t = ((gx - sx) / c_min, (gy - sy) / c_min) if c_min > 0 else (1.0, 0.0)
+    cx, cy = 0.5 * (sx + gx), 0.5 * (sy + gy)
+    from_ellipse = math.pi * a * b < h * w
+    x, y = 0.0, 0.0
+    for _ in range(INFORMED_TRIES):
+        if from_ellipse:
+            r = math.sqrt(next_double(s))
+            th = 2.0 * math.pi * next_double(s)
+            ex, ey = a * r * math.cos(th), b * r * math.sin(th)
+            x, y = cx + cos_t * ex - sin_t * ey, cy + sin_t * ex + cos_t * ey
+            if 0.0 <= x < w and 0.0 <= y < h:
+                return x, y
+        else:
+            x = _below(next_double(s) * w, float(w))
+            y = _below(next_double(s) * h, float(h))
+            if in_ellipse(x, y, sx, sy, gx, gy, c_best):
+                return x, y
+    return min(max(x, 0.0), w - 1e-9), min(max(y, 0.0), h - 1e-9)
+
+
+@njit(cache=True)
+def informed_point(s, h, w, mix, cdf, last, sx, sy, gx, gy, c_best):
+    """One informed sample: with probability ``mix`` a heatmap draw conditioned on the ellipse
+    (rejection, at most :data:`HEATMAP_TRIES` draws; when all fall outside, the heatmap has
+    next to no mass in the ellipse and the sample is uniform there instead), otherwise a
+    uniform point of the ellipse inside the map (:func:`ellipse_uniform`)."""
+    if mix > 0.0 and next_double(s) < mix:
+        for _ in range(HEATMAP_TRIES):
+            x, y = _heat_point(s, w, cdf, last)
+            if in_ellipse(x, y, sx, sy, gx, gy, c_best):
+                return x, y
+    return ellipse_uniform(s, h, w, sx, sy, gx, gy, c_best)
+
+
+@njit(cache=True)
+def _draw(s, n, h, w, mix, cdf, last, informed, sx, sy, gx, gy, c_best):
     out = np.empty((n, 2))
     for k in range(n):
-        out[k, 0], out[k, 1] = sample_point(s, h, w, mix, cdf, last)
+        if informed:
+            p = informed_point(s, h, w, mix, cdf, last, sx, sy, gx, gy, c_best)
+        else:
+            p = sample_point(s, h, w, mix, cdf, last)
+        out[k, 0], out[k, 1] = p
     return out
 
 
-def draw(sampler: Sampler, n: int, seed=0) -> np.ndarray:
-    """``n`` samples ``(n, 2)`` float64 (x, y) in pixels from ``sampler`` (for tests, plots)."""
+def draw(sampler: Sampler, n: int, seed=0, ellipse=None) -> np.ndarray:
+    """``n`` samples ``(n, 2)`` float64 (x, y) in pixels from ``sampler`` (for tests, plots);
+    ``ellipse=(start, goal, c_best)`` draws the informed samples of a run whose best solution
+    costs ``c_best``."""
     h, w = sampler.shape
     cdf = sampler.cdf if sampler.cdf.size else np.zeros(1)
-    return _draw(rng_state(seed), int(n), h, w, sampler.mix, cdf, max(sampler.last, 0))
+    (sx, sy), (gx, gy), c_best = ellipse if ellipse is not None else ((0, 0), (0, 0), 0.0)
+    return _draw(
+        rng_state(seed),
+        int(n),
+        h,
+        w,
+        sampler.mix,
+        cdf,
+        max(sampler.last, 0),
+        ellipse is not None,
+        float(sx),
+        float(sy),
+        float(gx),
+        float(gy),
+        float(c_best),
+    )
