@@ -6,7 +6,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 export PATH := $(CURDIR)/$(BIN):$(PATH)
 
-.PHONY: help setup test test-all lint format params repro bench clean
+.PHONY: help setup test test-all lint format params repro repro-cpu bench clean
 
 help:  ## list the targets
 	@grep -E '^[a-z-]+:.*## ' $(MAKEFILE_LIST) | awk -F':.*## ' '{printf "  %-10s %s\n", $$1, $$2}'
@@ -38,6 +38,14 @@ params: $(STAMP)  ## write params.yaml from conf/ (the default composition, as D
 
 repro: $(STAMP)  ## run the whole pipeline (dvc repro) at the default scale
 	$(BIN)/dvc repro
+
+CPU_REPORTS := reports/cpu
+repro-cpu: $(STAMP)  ## the CPU study scale (~2 h on 2 cores): both networks at train.seed 1, then the whole pipeline at seed 0; reports copied to reports/cpu/
+	$(BIN)/dvc exp run -S scale=cpu -S train.seed=1 predict_metrics
+	rm -rf $(CPU_REPORTS) && mkdir -p $(CPU_REPORTS)/seed1
+	cp reports/metrics/train_*.json reports/metrics/predict.json $(CPU_REPORTS)/seed1/
+	$(BIN)/dvc exp run -S scale=cpu
+	cp -r reports/paper_comparison.md reports/sampling_ideas.md reports/metrics reports/figures $(CPU_REPORTS)/
 
 bench: $(STAMP)  ## run the benchmarks
 	for f in benchmarks/bench_*.py; do $(BIN)/python $$f || exit 1; done

@@ -29,7 +29,8 @@ def test_params_yaml_leads_with_the_scale_and_the_ablation_keys():
 
 
 @pytest.mark.parametrize(
-    ("scale", "shards", "maps"), [("smoke", 2, 8), ("quick", 4, 200), ("paper", 100, 10_000)]
+    ("scale", "shards", "maps"),
+    [("smoke", 2, 8), ("quick", 4, 200), ("cpu", 8, 800), ("paper", 100, 10_000)],
 )
 def test_scales_compose_validate_and_paper_scale_matches_the_paper(scale, shards, maps):
     cfg = compose([f"scale={scale}"])

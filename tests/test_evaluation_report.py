@@ -128,3 +128,17 @@ def test_display_names_and_order():
         "m_vnrrt_star@0.5",
         "m_vnrrt_star@0.9",
     ]
+
+
+def test_networks_table_shows_shares_and_multiples_of_uniform():
+    from vnrrt.evaluation.report import networks_section
+
+    m = {"test/interior_recall": 0.25, "test/interior_ap": 0.12,
+         "test/mass_near_interior": 0.2, "test/mass_near_interior_uniform": 0.01,
+         "test/mass_near_interior_tau0_9": 0.05}  # fmt: skip
+    text = "\n".join(networks_section({"vertexnet": m}))
+    row = next(ln for ln in text.splitlines() if ln.startswith("| vertexnet | test |"))
+    cells = [c.strip() for c in row.strip("|").split("|")]
+    assert cells[2:5] == ["0.25", "0.12", "—"]
+    assert cells[5] == "0.2 (20.0x)" and cells[-1] == "0.05 (5.0x)"
+    assert "tau 0.9 mask" in text and networks_section({}) == []

@@ -153,8 +153,9 @@ def test_report_stage_writes_report_figures_metrics_and_nested_mlflow_runs(cfg, 
             {
                 "vertexnet": {
                     "ms_per_map": 15.0,
-                    "test/mass_near_vertex": 0.1,
-                    "test/mass_near_vertex_uniform": 0.02,
+                    "test/mass_near_interior": 0.1,
+                    "test/mass_near_interior_uniform": 0.02,
+                    "test/interior_ap": 0.12,
                 },
                 "nrrtnet": {
                     "ms_per_map": 14.0,
@@ -178,6 +179,8 @@ def test_report_stage_writes_report_figures_metrics_and_nested_mlflow_runs(cfg, 
         "| M-VNRRT* τ=0.5 | ours |",
         "## Informed sampling",
         "| informed VNRRT* |",
+        "## The networks' heatmaps",
+        "| vertexnet | test | — | 0.12 |",
     ):
         assert section in text, section
     assert "<br>" not in text
@@ -193,6 +196,7 @@ def test_report_stage_writes_report_figures_metrics_and_nested_mlflow_runs(cfg, 
     assert sum(headline["verdicts"].values()) == 16
     assert set(headline["opt_ms"]) == {"rrt", "nrrt", "vnrrt", "m0.5", "m0.9", "m0.99"}
     assert headline["mass_x_uniform"] == {"vertexnet": 5.0, "nrrtnet": 4.0}
+    assert headline["interior_ap"] == {"vertexnet": 0.12}
     mlflow.set_tracking_uri(cfg.logger.uri)
     runs = mlflow.search_runs(experiment_names=[cfg.logger.experiment])
     nested = runs["tags.mlflow.parentRunId"].notna()

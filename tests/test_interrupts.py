@@ -38,13 +38,13 @@ def test_a_signal_ends_a_shard_stage_within_seconds_and_leaves_nothing(tmp_path,
     """Ctrl-C in a terminal signals the whole process group; `kill` or a scheduler signals
     the stage's process alone, whose pool workers must then not be left running."""
     work = copy_pipeline(repo, tmp_path)
-    cfg = compose(["scale=quick", "scale.maps_per_shard=400", "workers=2"])
+    cfg = compose(["scale=quick", "scale.maps_per_shard=3000", "workers=2"])
     (work / "params.yaml").write_text(dump(cfg))
     env = dict(os.environ, PYTHONUNBUFFERED="1")
     proc = subprocess.Popen([sys.executable, "stages/shard.py", "--shard", "0"], cwd=work,
                             env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                             start_new_session=True)  # fmt: skip
-    time.sleep(4.0)  # the pool is up and working (400 maps take far longer)
+    time.sleep(4.0)  # the pool is up and working (3,000 maps take far longer)
     assert proc.poll() is None, proc.stdout.read().decode()
     workers = [p for p in group_alive(proc.pid) if p != proc.pid]
     assert workers, "no pool workers started"

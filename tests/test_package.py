@@ -1,6 +1,7 @@
 """vnrrt works outside the repository: a wheel installed into a fresh virtual environment
 runs `vnrrt plan` on a PNG map from another folder (no conf/, no source tree)."""
 
+import shutil
 import site
 import subprocess
 import sys
@@ -12,8 +13,12 @@ import numpy as np
 
 
 def test_the_wheel_plans_outside_the_repository(repo, tmp_path):
+    source = tmp_path / "source"  # a copy: setuptools leaves build/ in the tree it builds
+    shutil.copytree(repo / "src", source / "src", ignore=shutil.ignore_patterns("__pycache__"))
+    for name in ("pyproject.toml", "README.md", "LICENSE"):
+        shutil.copy(repo / name, source / name)
     subprocess.run([sys.executable, "-m", "pip", "wheel", "--no-deps", "--no-build-isolation",
-                    "-q", "-w", str(tmp_path / "dist"), str(repo)], check=True,
+                    "-q", "-w", str(tmp_path / "dist"), str(source)], check=True,
                    capture_output=True)  # fmt: skip
     wheel = next((tmp_path / "dist").glob("vnrrt-*.whl"))
     env_dir = tmp_path / "env"

@@ -186,3 +186,69 @@ def test_astar_is_optimal_where_the_heuristic_matters(seed):
         assert length == pytest.approx(ref, abs=1e-9)
         assert path_length(path) == pytest.approx(ref, abs=1e-9)
         assert_valid_path(grid, path, (sx, sy), (gx, gy))
+
+
+def turns(path) -> int:
+    """Direction changes along a cell path (T+1, 2)."""
+    steps = np.diff(np.asarray(path), axis=0)
+    return int(np.any(steps[1:] != steps[:-1], axis=1).sum())
+
+
+def distance_to_segment(points, a, b) -> np.ndarray:
+    """Distances (N,) of cell centres ``points`` (N, 2) to the segment between centres a, b."""
+    p, a, b = np.asarray(points) + 0.5, np.asarray(a) + 0.5, np.asarray(b) + 0.5
+    t = np.clip(((p - a) @ (b - a)) / ((b - a) @ (b - a)), 0, 1)
+    return np.linalg.norm(p - (a + t[:, None] * (b - a)), axis=1)
+
+
+TIE_OPTIONS = [("turns", 0.0), ("line", 0.0), ("line", 3.0), ("exact", 0.0), ("exact", 3.0)]
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.integers(0, 10**6), st.floats(0.0, 0.35))
+def test_every_tie_break_gives_an_equally_short_valid_path(seed, density):
+    rng = np.random.default_rng(seed)
+    grid = (rng.random((24, 24)) < density).astype(np.uint8)
+    free = np.argwhere(grid == 0)
+    if len(free) < 2:
+        return
+    (sy, sx), (gy, gx) = free[rng.choice(len(free), 2, replace=False)]
+    try:
+        _, want = astar(grid, (sx, sy), (gx, gy))
+    except NoPathError:
+        return
+    for tie_break, tol in TIE_OPTIONS:
+        path, length = astar(grid, (sx, sy), (gx, gy), tie_break, tol)
+        assert length == want and path_length(path) == pytest.approx(want, abs=1e-9)
+        assert_valid_path(grid, path, (sx, sy), (gx, gy))
+
+
+def test_tie_breaks_have_their_documented_shape_in_free_space():
+    """From (2, 3) to (33, 14) in an empty grid every octile path of 11 diagonal and 20
+    straight moves is optimal: ``turns`` takes one or two bends (A* settles only part of
+    the field, so a straight run can end early); ``line`` (and ``exact``, whose
+    optimum is the same segment) stay within a cell's half-diagonal of the straight line;
+    a tolerance lets them run straight longer, so fewer turns, never farther than it plus
+    a cell from the line."""
+    grid, s, g = np.zeros((20, 40), np.uint8), (2, 3), (33, 14)
+    paths = {opt: astar(grid, s, g, *opt)[0] for opt in TIE_OPTIONS}
+    assert 1 <= turns(paths["turns", 0.0]) <= 2
+    for tie_break in ("line", "exact"):
+        hug = paths[tie_break, 0.0]
+        assert distance_to_segment(hug, s, g).max() <= math.sqrt(2) / 2 + 1e-9
+        loose = paths[tie_break, 3.0]
+        assert distance_to_segment(loose, s, g).max() <= 3.0 + math.sqrt(2) + 1e-9
+        assert turns(paths["turns", 0.0]) <= turns(loose) < turns(hug)
+
+
+def test_line_tie_break_bends_at_the_obstacle_corner():
+    """A wall between start and goal: the exact optimum bends at the wall's end corner; the
+    ``line`` and ``exact`` label paths pass within 1.5 px of that corner cell, ``turns``
+    (an L-shaped octile path) need not."""
+    grid = np.zeros((30, 30), np.uint8)
+    grid[5:30, 15] = 1  # a wall x = 15 from y = 5 down; its free end corner near (15, 4)
+    s, g = (3, 25), (27, 25)
+    corner = np.array([15.5, 4.5])  # the corner region above the wall
+    for tie_break in ("line", "exact"):
+        path = astar(grid, s, g, tie_break)[0] + 0.5
+        assert np.linalg.norm(path - corner, axis=1).min() <= 1.5

@@ -7,10 +7,12 @@ from torchmetrics.classification import BinaryAveragePrecision
 
 from vnrrt.data.targets import dilate as dilate_numpy
 from vnrrt.model.metrics import (
+    MaskedAveragePrecision,
     MassNear,
     PixelAveragePrecision,
     VertexRecall,
     dilate,
+    heatmap_metrics,
     metric_collection,
 )
 
@@ -52,17 +54,17 @@ def test_vertex_recall_hand_computed():
     vertices = mask((5, 5), (0, 0), (4, 4))
     preds = torch.zeros(1, 5, 5)
     preds[0, 1, 1] = 0.7  # (x=1, y=1): sqrt(2) from (0, 0), far from (4, 4)
-    assert VertexRecall(radius=1, tau=0.5)(preds, vertices) == 0.0  # sqrt 2 > 1
-    assert VertexRecall(radius=1.5, tau=0.5)(preds, vertices) == 0.5
-    assert VertexRecall(radius=1.5, tau=0.8)(preds, vertices) == 0.0  # 0.7 < tau
+    assert VertexRecall(radius=1, tau=0.5)(preds, vertices=vertices) == 0.0  # sqrt 2 > 1
+    assert VertexRecall(radius=1.5, tau=0.5)(preds, vertices=vertices) == 0.5
+    assert VertexRecall(radius=1.5, tau=0.8)(preds, vertices=vertices) == 0.0  # 0.7 < tau
     preds[0, 4, 4] = 0.5  # exactly tau counts
-    assert VertexRecall(radius=0, tau=0.5)(preds, vertices) == 0.5
+    assert VertexRecall(radius=0, tau=0.5)(preds, vertices=vertices) == 0.5
 
 
 def test_vertex_recall_pools_vertices_over_images():
     metric = VertexRecall(radius=0, tau=0.5)
-    metric.update(torch.ones(1, 4, 4), mask((4, 4), (0, 0)))  # 1 of 1
-    metric.update(torch.zeros(1, 4, 4), mask((4, 4), (1, 1), (2, 2), (3, 3)))  # 0 of 3
+    metric.update(torch.ones(1, 4, 4), vertices=mask((4, 4), (0, 0)))  # 1 of 1
+    metric.update(torch.zeros(1, 4, 4), vertices=mask((4, 4), (1, 1), (2, 2), (3, 3)))  # 0 of 3
     assert metric.compute() == pytest.approx(0.25)
 
 
@@ -103,10 +105,58 @@ def test_collection_keys_and_perfect_prediction():
     metrics = metric_collection(radius=0, tau=0.5).clone(prefix="val/")
     target = mask((6, 6), (1, 1), (4, 2))
     preds = target.float() * 0.9  # (1, 6, 6)
-    out = metrics(preds=preds, target=target.to(torch.uint8), vertices=target, path=target)
+    ends = mask((6, 6), (1, 1))
+    interior = mask((6, 6), (4, 2))
+    out = metrics(preds=preds, target=target.to(torch.uint8), vertices=target, path=target,
+                  interior=interior, endpoints=ends)  # fmt: skip
+    masked = [f"mass_near_interior_tau{t}" for t in ("0_5", "0_9", "0_99")]
     assert set(out) == {f"val/{k}" for k in ("ap", "f1", "vertex_recall", "mass_near_path",
-                        "mass_near_path_uniform", "mass_near_vertex",
-                        "mass_near_vertex_uniform", "mass_near_vertex_masked")}  # fmt: skip
+                        "mass_near_path_uniform", "mass_near_vertex", "interior_recall",
+                        "mass_near_vertex_uniform", "mass_near_vertex_masked", "interior_ap",
+                        "path_ap", "mass_near_interior", "mass_near_interior_uniform",
+                        "mass_on_endpoints", *masked)}  # fmt: skip
     assert out["val/ap"] == pytest.approx(1.0) and out["val/f1"] == pytest.approx(1.0)
     assert out["val/vertex_recall"] == 1.0 and out["val/mass_near_vertex"] == pytest.approx(1.0)
     assert out["val/mass_near_vertex_uniform"] == pytest.approx(2 / 36)
+
+
+def interior_case():
+    """A 20x20 image: start (1, 1) and goal (18, 18) carry most of the heatmap's mass, one
+    interior vertex (10, 4) a little, another (4, 12) none; one false peak at (15, 5)."""
+    ends, interior = mask((20, 20), (1, 1), (18, 18)), mask((20, 20), (10, 4), (4, 12))
+    preds = torch.zeros(1, 20, 20)
+    preds[0, 1, 1] = preds[0, 18, 18] = 0.95  # the endpoints
+    preds[0, 4, 10] = 0.6  # found interior vertex
+    preds[0, 5, 15] = 0.7  # a false positive, ranked above the true one
+    return preds, {"endpoints": ends, "interior": interior, "vertices": ends | interior}
+
+
+def test_interior_metrics_leave_the_endpoints_out():
+    preds, masks = interior_case()
+    m = heatmap_metrics(radius=0, tau=0.5, taus=(0.5, 0.9), endpoint_radius=0)
+    out = {k: float(v(preds, path=masks["vertices"], **masks)) for k, v in m.items()}
+    assert out["vertex_recall"] == pytest.approx(3 / 4)  # the endpoints count here ...
+    assert out["interior_recall"] == pytest.approx(1 / 2)  # ... not here
+    total = 0.95 * 2 + 0.6 + 0.7
+    assert out["mass_on_endpoints"] == pytest.approx(1.9 / total)
+    assert out["mass_near_interior"] == pytest.approx(0.6 / total)
+    assert out["mass_near_interior_uniform"] == pytest.approx(2 / 400)
+    assert out["mass_near_interior_tau0_5"] == pytest.approx(0.6 / total)  # all kept at 0.5
+    assert out["mass_near_interior_tau0_9"] == pytest.approx(0.0)  # only the endpoints kept
+    # AP over the interior positives, the endpoint pixels ignored: precision 0 at the false
+    # peak's level (0.7), 1/2 once the true one (0.6) is in (recall 1/2); the unfound one
+    # only at threshold 0, where all 398 kept pixels count (precision 2/398).
+    ap = MaskedAveragePrecision("interior", 0.0, "endpoints", 0.0)(preds, **masks)
+    assert float(ap) == pytest.approx(0.5 * 0.5 + 0.5 * 2 / 398)
+    with_ends = MaskedAveragePrecision("vertices", 0.0)(preds, **masks)
+    assert float(with_ends) > float(ap)  # the confident endpoints raise the plain AP
+
+
+def test_masked_ap_dilates_positives():
+    preds, masks = interior_case()
+    shifted = torch.zeros_like(preds)
+    shifted[0, 4, 11] = 0.9  # one pixel right of the interior vertex (10, 4)
+    strict = MaskedAveragePrecision("interior", 0.0)(shifted, **masks)
+    loose = MaskedAveragePrecision("interior", 1.0)(shifted, **masks)
+    assert float(strict) == pytest.approx(2 / 400)  # only at threshold 0: all pixels
+    assert float(loose) == pytest.approx(1 / 10 + 0.9 * 10 / 400)  # 1 of 10 found, at 0.9

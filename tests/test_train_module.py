@@ -24,31 +24,36 @@ def test_fast_dev_run_of_the_real_smoke_config(smoke_data, tmp_path):
     saved = json.loads((tmp_path / "metrics" / "train_vertexnet.json").read_text())
     assert saved["steps"] == 1 and "test/mass_near_vertex_uniform" in saved
     net, record = load_network(tmp_path / "models" / "vertexnet.ckpt", "vertexnet")
-    assert record["target"] == {"kind": "vertex", "radius": 0.0}
+    assert record["target"] == {"kind": "vertex", "endpoints": "both", "radius": 0.0}
     assert record["net"]["encoder_width"] == cfg.model.net.encoder_width
     assert net(torch.rand(1, 3, 200, 200)).shape == (1, 2, 200, 200)
 
 
-def recall_on(net, batch) -> float:
+def recall_on(net, batch, mask: str = "interior") -> float:
     with torch.no_grad():
         probs = net.eval()(batch["image"]).softmax(1)[:, 1]
-    return float(VertexRecall(radius=1.0, tau=0.5)(probs, batch["vertices"]))
+    return float(VertexRecall(radius=1.0, tau=0.5, mask=mask)(probs, **{mask: batch[mask]}))
 
 
-def test_overfitting_a_handful_of_instances_drives_vertex_recall_up(small_data, tmp_path):
+def test_overfitting_a_handful_of_instances_drives_interior_recall_up(small_data, tmp_path):
+    """Four instances learnt by heart: the vertices between start and goal are found, not
+    only the start and goal (whose disks are drawn in the input)."""
     cfg = small_cfg(small_data, tmp_path, "train.datamodule.train_instances=4",
                     "train.datamodule.batch_size=4", "trainer.max_epochs=80",
-                    "trainer.limit_val_batches=0", "networks.vertexnet.radius=1.0",
+                    "trainer.limit_val_batches=0", "train.datamodule.target_radius=1.0",
                     "train.module.scheduler=null", "train.module.optimizer.lr=3e-3")  # fmt: skip
     dm = instantiate(cfg.train.datamodule, target="vertex", target_radius=1.0)
     dm.setup("fit")
     batch = next(iter(dm.train_dataloader()))
     assert len(batch["image"]) == 4
     torch.manual_seed(0)
+    assert batch["interior"].sum() >= 4  # interior vertices to find
     before = recall_on(instantiate(cfg.model.net), batch)
     train(cfg, "vertexnet")
-    after = recall_on(load_network(tmp_path / "models" / "vertexnet.ckpt")[0], batch)
+    net = load_network(tmp_path / "models" / "vertexnet.ckpt")[0]
+    after = recall_on(net, batch)
     assert before == 0.0 and after >= 0.8, (before, after)
+    assert recall_on(net, batch, "endpoints") >= 0.8
 
 
 def test_a_resumed_run_ends_where_an_uninterrupted_one_does(small_data, tmp_path, monkeypatch):
@@ -164,3 +169,43 @@ def test_a_bit_flipped_checkpoint_is_refused(trained, tmp_path):
     checksum_file(bad).unlink()
     with pytest.raises(CheckpointError, match="has no recorded sha256"):
         load_network(bad, "vertexnet", verify=True)
+
+
+def test_two_runs_write_identical_checkpoints_and_metrics(small_data, tmp_path):
+    """The same stage twice (here in two folders, with a time cap, one thread): identical
+    checkpoint bytes, hence checksums, and identical metrics but for the timings."""
+    before = torch.get_num_threads()
+    try:
+        runs = [train(small_cfg(small_data, tmp_path / run, *QUICK, "train.threads=1",
+                                "trainer.max_time={minutes: 5}"), "vertexnet")
+                for run in ("a", "b")]  # fmt: skip
+    finally:
+        torch.set_num_threads(before)
+    files = [(tmp_path / run / "models" / "vertexnet.ckpt").read_bytes() for run in ("a", "b")]
+    assert files[0] == files[1]
+    timing = ("fit_seconds", "train_images_per_s")
+    a, b = ({k: v for k, v in r.items() if k not in timing} for r in runs)
+    assert a == b and a["threads"] == 1 and a["steps"] == 2
+
+
+def test_training_metrics_update_on_every_nth_batch_only():
+    from torch import nn
+
+    from vnrrt.model.loss import FocalLoss
+    from vnrrt.model.module import VertexNetModule
+
+    module = VertexNetModule(nn.Conv2d(3, 2, 1), FocalLoss(), torch.optim.SGD,
+                             train_metrics_every=3)  # fmt: skip
+    module.log = module.log_dict = lambda *a, **k: None  # no trainer attached
+    masks = {k: torch.zeros(2, 8, 8, dtype=torch.bool) for k in
+             ("vertices", "path", "interior", "endpoints")}  # fmt: skip
+    batch = {"image": torch.rand(2, 3, 8, 8), "target": torch.zeros(2, 8, 8, dtype=torch.long),
+             **masks}  # fmt: skip
+    metric = module.train_metrics["vertex_recall"]
+    for i in range(7):
+        module.training_step(batch, i)
+    assert metric._update_count == 3  # batches 0, 3 and 6
+    module.validation_step(batch, 1)
+    assert module.val_metrics["vertex_recall"]._update_count == 1  # always in val and test
+    with pytest.raises(ValueError, match="train_metrics_every"):
+        VertexNetModule(nn.Conv2d(3, 2, 1), FocalLoss(), torch.optim.SGD, train_metrics_every=0)

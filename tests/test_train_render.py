@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from vnrrt.data.targets import cells_mask, check_target, dilate, target_mask
+from vnrrt.data.targets import cells_mask, check_target, dilate, label_masks, target_mask
 from vnrrt.grid import GridError, disk
 from vnrrt.maps.render import (
     IMAGENET_MEAN,
@@ -105,3 +105,29 @@ def test_vertex_and_path_targets():
         check_target("corner", 0)
     with pytest.raises(ValueError, match="radius"):
         check_target("path", -1)
+    with pytest.raises(ValueError, match="endpoints 'start'"):
+        check_target("vertex", 0, "start")
+
+
+@pytest.mark.parametrize("radius", [0, 1])
+def test_target_endpoints_options(radius):
+    """``both`` keeps start (0,0) and goal (4,2), ``goal`` drops the start, ``none`` both;
+    the same pixels for either kind, each dilated by the same disk."""
+    path = np.array([[0, 0], [1, 1], [2, 2], [3, 2], [4, 2]])
+    vertices = path[[0, 2, 4]]
+    for kind, cells in (("vertex", vertices), ("path", path)):
+        for ends, dropped in (("both", []), ("goal", [0]), ("none", [0, len(cells) - 1])):
+            got = target_mask(path, vertices, (5, 5), kind, radius, ends)
+            want = cells_mask(np.delete(cells, dropped, axis=0), (5, 5), radius)
+            np.testing.assert_array_equal(got, want)
+    none = target_mask(path, vertices, (5, 5), "vertex", 0, "none")
+    assert none.sum() == 1 and none[2, 2]  # only the interior vertex (2, 2)
+
+
+def test_label_masks_split_the_vertices():
+    path = np.array([[0, 0], [1, 1], [2, 2], [3, 2], [4, 2]])
+    m = label_masks(path, path[[0, 2, 4]], (5, 5))
+    assert m["path"].sum() == 5 and m["vertices"].sum() == 3
+    assert m["interior"].sum() == 1 and m["interior"][2, 2]
+    assert m["endpoints"].sum() == 2 and m["endpoints"][0, 0] and m["endpoints"][2, 4]
+    np.testing.assert_array_equal(m["interior"] | m["endpoints"], m["vertices"])

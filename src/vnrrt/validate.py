@@ -13,13 +13,13 @@ from omegaconf import DictConfig
 
 from vnrrt.config import ConfigError, check, check_parts, section
 from vnrrt.data.config import LabelsConfig, ScaleConfig
+from vnrrt.data.targets import ENDPOINTS
+from vnrrt.data.targets import TARGETS as NETWORK_TARGETS
 from vnrrt.evaluation.config import EvalConfig, StatsConfig
 from vnrrt.evaluation.protocol import parse_key
 from vnrrt.evaluation.study import OracleConfig, RegimeConfig
 from vnrrt.maps.config import DataConfig
 from vnrrt.planners.config import PlannerConfig
-
-NETWORK_TARGETS = ("vertex", "path")
 
 
 def _taus(planner: PlannerConfig) -> None:
@@ -38,13 +38,14 @@ def _networks(cfg: DictConfig) -> set[str]:
             target,
             f"must be one of {NETWORK_TARGETS}",
         )
-        radius = spec.get("radius", 0)
-        check(
-            isinstance(radius, int | float) and radius >= 0,
-            f"networks.{name}.radius",
-            radius,
-            "must be >= 0 pixels",
-        )
+        ends = spec.get("endpoints", "both")
+        check(ends in ENDPOINTS, f"networks.{name}.endpoints", ends, f"must be one of {ENDPOINTS}")
+    train_seed = cfg.get("train", {}).get("seed", 0)
+    ok = isinstance(train_seed, int) and train_seed >= 0
+    check(ok, "train.seed", train_seed, "must be an integer >= 0")
+    radius = cfg.get("train", {}).get("datamodule", {}).get("target_radius", 0.0)
+    ok = isinstance(radius, int | float) and radius >= 0
+    check(ok, "train.datamodule.target_radius", radius, "must be >= 0 pixels")
     return set(nets)
 
 

@@ -28,7 +28,7 @@ log = logging.getLogger(__name__)
 def make_map(map_id: int, seed: int, data: DataConfig, labels: LabelsConfig):
     """Generate and label global map ``map_id``; returns ``(FloorMap, MapLabels)``."""
     fm = generate_map(map_rng(seed, map_id), data)
-    return fm, label_map(fm, labels.vertex_steps)
+    return fm, label_map(fm, labels.vertex_steps, labels.tie_break, labels.tie_tolerance)
 
 
 def split_of_maps(seed: int, shard_id: int, n_maps: int, train_fraction: float) -> np.ndarray:

@@ -13,10 +13,15 @@ class LabelsConfig:
     """Vertex labelling (paper, Method/Ground Truth)."""
 
     vertex_steps: list[int] = field(default_factory=lambda: [1, 2, 3])
+    tie_break: str = "line"  # among equally short A* paths: turns | line | exact
+    tie_tolerance: float = 8.0  # px: line/exact keep the direction while this near the guide
 
     def validate(self) -> None:
         ok = bool(self.vertex_steps) and all(k >= 1 for k in self.vertex_steps)
         check(ok, "labels.vertex_steps", self.vertex_steps, "must be positive step sizes")
+        known = ("turns", "line", "exact")
+        check(self.tie_break in known, "labels.tie_break", self.tie_break, f"one of {known}")
+        check(self.tie_tolerance >= 0, "labels.tie_tolerance", self.tie_tolerance, "must be >= 0")
 
 
 @dataclass

@@ -4,7 +4,7 @@ Splits are by base map, so no map lends instances to two splits: the shards' tes
 ``test`` split; of each shard's train maps a seeded ``val_fraction`` (by ``(seed, shard id)``)
 form ``val``, the rest ``train``. Instances are keyed ``(shard position, instance index)`` in
 shard order; ``*_instances`` limits keep evenly spaced keys (spread over many maps, no RNG).
-The training loader shuffles each epoch with a generator seeded by ``(seed, epoch)``
+The training loader shuffles each epoch with a generator seeded by ``(shuffle_seed, epoch)``
 (:class:`EpochShuffle`, so resuming mid-run repeats no batch order); workers are seeded by
 Lightning (``seed_everything(seed, workers=True)``) and the dataset itself draws no random
 numbers, so an item depends only on its key.
@@ -23,9 +23,8 @@ from torch.utils.data import DataLoader, Dataset, Sampler
 from vnrrt.data.manifest import verified_files
 from vnrrt.data.reader import Shard
 from vnrrt.data.splits import SPLIT_NAMES, evenly_spaced, split_keys
-from vnrrt.data.targets import check_target, target_mask
+from vnrrt.data.targets import check_target, label_masks, target_mask
 from vnrrt.maps.render import NORMALIZATIONS, class_map, colorize, to_input
-from vnrrt.search import path_mask
 
 log = logging.getLogger(__name__)
 
@@ -35,18 +34,21 @@ class InstanceDataset(Dataset):
     shard ``files``. Each item is a dict (``S`` = map size):
 
     ``image`` (3, S, S) float32 network input; ``classes`` (S, S) uint8 pixel classes;
-    ``target`` (S, S) uint8 training target; ``vertices`` and ``path`` (S, S) bool A* vertex
-    and path cells (undilated, for the metrics); ``key`` (2,) int64 (shard id, instance).
+    ``target`` (S, S) uint8 training target; ``vertices``, ``path``, ``interior`` and
+    ``endpoints`` (S, S) bool A* label cells (undilated, for the metrics:
+    :func:`vnrrt.data.targets.label_masks`); ``key`` (2,) int64 (shard id, instance).
     """
 
     def __init__(self, files, shard_ids, keys, target="vertex", target_radius=0.0,
-                 marker_radius=2.0, normalize="imagenet") -> None:  # fmt: skip
-        check_target(target, target_radius)
+                 target_endpoints="both", marker_radius=2.0,
+                 normalize="imagenet") -> None:  # fmt: skip
+        check_target(target, target_radius, target_endpoints)
         if normalize not in NORMALIZATIONS:
             raise ValueError(f"normalize must be one of {NORMALIZATIONS}, got {normalize!r}")
         self.files, self.shard_ids = [Path(f) for f in files], list(shard_ids)
         self.keys = np.asarray(keys, np.int64).reshape(-1, 2)
         self.target, self.target_radius = target, target_radius
+        self.target_endpoints = target_endpoints
         self.marker_radius, self.normalize = marker_radius, normalize
         self._shards: dict[int, Shard] = {}
 
@@ -67,13 +69,15 @@ class InstanceDataset(Dataset):
         path, vertices = shard.path(i), shard.vertices(i)
         classes = class_map(grid, inst["start"], inst["goal"], self.marker_radius)
         shape = grid.shape
-        target = target_mask(path, vertices, shape, self.target, self.target_radius)
+        target = target_mask(
+            path, vertices, shape, self.target, self.target_radius, self.target_endpoints
+        )
+        masks = {k: torch.from_numpy(v) for k, v in label_masks(path, vertices, shape).items()}
         return {
             "image": torch.from_numpy(to_input(colorize(classes), self.normalize)),
             "classes": torch.from_numpy(classes),
             "target": torch.from_numpy(target.astype(np.uint8)),
-            "vertices": torch.from_numpy(path_mask(vertices, shape)),
-            "path": torch.from_numpy(path_mask(path, shape)),
+            **masks,
             "key": torch.tensor([self.shard_ids[pos], i], dtype=torch.int64),
         }
 
@@ -107,29 +111,35 @@ class ShardDataModule(L.LightningDataModule):
     Args:
         shards_dir, manifest: where the shards and their manifest are (``paths`` config).
         shards: shard ids to use (``scale.shards``).
-        target, target_radius: training target (``vertex``/``path``) and its dilation (px).
+        target, target_radius, target_endpoints: training target (``vertex``/``path``), its
+            dilation (px) and the path ends it keeps (:mod:`vnrrt.data.targets`).
         marker_radius, normalize: start/goal disk radius (px) and input normalisation
             (:mod:`vnrrt.maps.render`).
         val_fraction: share of each shard's train maps held out for validation.
         train_instances, val_instances, test_instances: evenly spaced subsets (None: all).
         batch_size: per process; num_workers: loader processes (0: in the main process).
-        seed: split and shuffling seed.
+        seed: split seed; shuffle_seed: shuffling seed (None: ``seed``), so that a training
+            seed (``train.seed``) changes the batch order but not the validation maps.
     """
 
     def __init__(self, shards_dir: str, manifest: str, shards: list[int], target: str = "vertex",
-                 target_radius: float = 0.0, marker_radius: float = 2.0,
+                 target_radius: float = 0.0, target_endpoints: str = "both",
+                 marker_radius: float = 2.0,
                  normalize: str = "imagenet", val_fraction: float = 0.1,
                  train_instances: int | None = None, val_instances: int | None = 256,
                  test_instances: int | None = 256, batch_size: int = 16, num_workers: int = 0,
-                 pin_memory: bool = False, seed: int = 0) -> None:  # fmt: skip
+                 pin_memory: bool = False, seed: int = 0,
+                 shuffle_seed: int | None = None) -> None:  # fmt: skip
         super().__init__()
-        check_target(target, target_radius)
+        check_target(target, target_radius, target_endpoints)
         if batch_size < 1 or num_workers < 0:
             raise ValueError(f"need batch_size >= 1, num_workers >= 0: {batch_size}, {num_workers}")
         self.shards_dir, self.manifest, self.shard_ids = shards_dir, manifest, list(shards)
         self.item_args = {"target": target, "target_radius": target_radius,
-                          "marker_radius": marker_radius, "normalize": normalize}  # fmt: skip
+                          "target_endpoints": target_endpoints, "marker_radius": marker_radius,
+                          "normalize": normalize}  # fmt: skip
         self.val_fraction, self.seed = val_fraction, seed
+        self.shuffle_seed = seed if shuffle_seed is None else shuffle_seed
         self.limits = {"train": train_instances, "val": val_instances, "test": test_instances}
         self.batch_size, self.num_workers, self.pin_memory = batch_size, num_workers, pin_memory
         self.datasets: dict[str, InstanceDataset] = {}
@@ -148,7 +158,7 @@ class ShardDataModule(L.LightningDataModule):
 
     def _loader(self, split: str, shuffle: bool = False) -> DataLoader:
         data = self.datasets[split]
-        sampler = EpochShuffle(len(data), self.seed) if shuffle else None
+        sampler = EpochShuffle(len(data), self.shuffle_seed) if shuffle else None
         return DataLoader(
             data, batch_size=self.batch_size, sampler=sampler, num_workers=self.num_workers,
             pin_memory=self.pin_memory, persistent_workers=self.num_workers > 0,

@@ -1,9 +1,9 @@
 """Ground truth of one base map: optimal paths and vertices for every start x goal pair.
 
 One exact Dijkstra search from each goal (stopped once all starts are settled) serves all
-starts of that goal; each path is then read off the distance field with the fewest-turns
-tie-breaking of :func:`vnrrt.search.descend`, so it is identical to
-``vnrrt.search.astar(grid, start, goal)``'s path in all but rare ties.
+starts of that goal; each path is then read off the distance field with the tie-breaking
+of :func:`vnrrt.search.descend` (``labels.tie_break``), so it is identical to
+``vnrrt.search.astar(grid, start, goal, tie_break)``'s path in all but rare ties.
 """
 
 from __future__ import annotations
@@ -15,7 +15,14 @@ from numba import njit
 
 from vnrrt.grid import MOVES
 from vnrrt.maps.generate import FloorMap
-from vnrrt.search.astar import EPS, NoPathError, descend_kernel, distance_field, move_masks
+from vnrrt.search.astar import (
+    EPS,
+    NoPathError,
+    descend_kernel,
+    distance_field,
+    guide_for,
+    move_masks,
+)
 from vnrrt.search.vertices import vertex_flags
 
 
@@ -42,8 +49,10 @@ class MapLabels:
 
 
 @njit(cache=True)
-def _label_goal(masks, dist, starts, gx, gy, steps, eps):
-    """Paths from every start ``(K, 2)`` down ``dist`` to the goal, and their vertices.
+def _label_goal(masks, dist, starts, gx, gy, steps, eps, guides, goff, tol):
+    """Paths from every start ``(K, 2)`` down ``dist`` to the goal, and their vertices;
+    start ``i`` breaks ties along ``guides[goff[i]:goff[i+1]]`` (empty: fewest turns) within
+    ``tol`` px.
 
     Returns ``(moves, n_moves, vsteps, n_vertices, ok)``: concatenated chain codes (uint8),
     moves per path (K,), concatenated vertex path indices (uint32), vertices per path (K,).
@@ -54,7 +63,8 @@ def _label_goal(masks, dist, starts, gx, gy, steps, eps):
     n_vert = np.zeros(k, np.int64)
     for i in range(k):
         sx, sy = starts[i, 0], starts[i, 1]
-        moves, ok = descend_kernel(masks, dist, sx, sy, gx, gy, eps)
+        guide = guides[goff[i] : goff[i + 1]]
+        moves, ok = descend_kernel(masks, dist, sx, sy, gx, gy, eps, guide, tol)
         if not ok:
             return np.zeros(0, np.uint8), n_moves, np.zeros(0, np.uint32), n_vert, False
         path = np.empty((len(moves) + 1, 2), np.int64)
@@ -80,8 +90,20 @@ def _concat(parts, out):
     return out
 
 
-def label_map(fm: FloorMap, steps: list[int] | tuple[int, ...] = (1, 2, 3)) -> MapLabels:
-    """Optimal paths and vertices of all start x goal pairs of ``fm`` (goal-major order)."""
+def _guides(grid, starts, goal, tie_break: str) -> tuple[np.ndarray, np.ndarray]:
+    """The tie-break polylines of every start towards ``goal``, flat with offsets."""
+    parts = [guide_for(tie_break, grid, tuple(s), tuple(goal)) for s in starts]
+    goff = np.zeros(len(parts) + 1, np.int64)
+    np.cumsum([len(p) for p in parts], out=goff[1:])
+    flat = np.concatenate(parts) if goff[-1] else np.zeros((0, 2))
+    return np.ascontiguousarray(flat, np.float64), goff
+
+
+def label_map(fm: FloorMap, steps: list[int] | tuple[int, ...] = (1, 2, 3),
+              tie_break: str = "turns", tolerance: float = 0.0) -> MapLabels:  # fmt: skip
+    """Optimal paths and vertices of all start x goal pairs of ``fm`` (goal-major order);
+    ``tie_break`` and ``tolerance`` (px) choose among equally short paths
+    (:func:`vnrrt.search.astar.descend_kernel`)."""
     masks = move_masks(np.ascontiguousarray(fm.grid, np.uint8))
     starts = np.ascontiguousarray(fm.starts, np.int64)
     steps_arr = np.asarray(steps, np.int64)
@@ -91,8 +113,9 @@ def label_map(fm: FloorMap, steps: list[int] | tuple[int, ...] = (1, 2, 3)) -> M
         dist = distance_field(masks, goal, starts)
         if not np.all(np.isfinite(dist[starts[:, 1], starts[:, 0]])):
             raise NoPathError(f"goal {tuple(goal)} does not reach every start of its map")
+        guides, goff = _guides(fm.grid, starts, goal, tie_break)
         moves, n_moves, vsteps, n_vert, ok = _label_goal(
-            masks, dist, starts, int(goal[0]), int(goal[1]), steps_arr, EPS
+            masks, dist, starts, int(goal[0]), int(goal[1]), steps_arr, EPS, guides, goff, tolerance
         )
         if not ok:
             raise RuntimeError(f"inconsistent distance field for goal {tuple(goal)}")

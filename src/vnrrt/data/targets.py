@@ -1,10 +1,14 @@
 """Training targets (paper, Ground Truth): binary ``(H, W)`` masks built from a shard's labels.
 
-* ``vertex`` (VertexNet): the vertices of the A* path, start and goal included.
+* ``vertex`` (VertexNet): the vertices of the A* path.
 * ``path`` (the NRRT* baseline network): every cell of the A* path.
 
-Each can be dilated by a disk of ``radius`` pixels (:func:`vnrrt.grid.disk`; 0 = the cells
-alone, the paper's reading). Masks are indexed ``mask[y, x]`` like grids.
+``endpoints`` says which of the path's two ends the target keeps (:data:`ENDPOINTS`):
+``both`` (the paper's figure, whose segments end at start and goal), ``goal`` (the goal
+only: the root of the tree needs no samples), ``none`` (the paper's turning formula, which
+needs ``x_{i-3}`` and so never marks the first or last cells). Both kinds are dilated by the
+same disk of ``radius`` pixels (:func:`vnrrt.grid.disk`; 0 = the cells alone, the paper's
+reading). Masks are indexed ``mask[y, x]`` like grids.
 """
 
 from __future__ import annotations
@@ -15,6 +19,7 @@ import numpy as np
 from vnrrt.grid import disk
 
 TARGETS = ("vertex", "path")
+ENDPOINTS = ("both", "goal", "none")
 
 
 def dilate(mask: np.ndarray, radius: float) -> np.ndarray:
@@ -35,19 +40,47 @@ def cells_mask(cells: np.ndarray, shape: tuple[int, int], radius: float = 0.0) -
     return dilate(mask, radius)
 
 
-def check_target(kind: str, radius: float) -> None:
-    """Raise ``ValueError`` for an unknown target kind or a negative radius."""
+def check_target(kind: str, radius: float, endpoints: str = "both") -> None:
+    """Raise ``ValueError`` for an unknown target kind or endpoints option, or a negative
+    radius."""
     if kind not in TARGETS:
         raise ValueError(f"unknown target {kind!r}; expected one of {TARGETS}")
+    if endpoints not in ENDPOINTS:
+        raise ValueError(f"unknown target endpoints {endpoints!r}; expected one of {ENDPOINTS}")
     if not radius >= 0:
         raise ValueError(f"target radius must be >= 0 pixels, got {radius!r}")
 
 
-def target_mask(
-    path: np.ndarray, vertices: np.ndarray, shape: tuple[int, int], kind: str, radius: float = 0
-) -> np.ndarray:
+def _drop_ends(cells: np.ndarray, path: np.ndarray, endpoints: str) -> np.ndarray:
+    """``cells`` (K, 2) without the path's start (``goal``) or start and goal (``none``)."""
+    drop = {"both": [], "goal": [path[0]], "none": [path[0], path[-1]]}[endpoints]
+    keep = np.ones(len(cells), bool)
+    for end in drop:
+        keep &= np.any(cells != end, axis=1)
+    return cells[keep]
+
+
+def target_mask(path: np.ndarray, vertices: np.ndarray, shape: tuple[int, int], kind: str,
+                radius: float = 0, endpoints: str = "both") -> np.ndarray:  # fmt: skip
     """The ``(H, W)`` bool target of one instance from its A* ``path`` ``(T+1, 2)`` and its
-    ``vertices`` ``(K, 2)`` (cells x, y): ``kind`` ``"vertex"`` or ``"path"``, dilated by
-    ``radius`` pixels."""
-    check_target(kind, radius)
-    return cells_mask(vertices if kind == "vertex" else path, shape, radius)
+    ``vertices`` ``(K, 2)`` (cells x, y): ``kind`` ``"vertex"`` or ``"path"``, keeping
+    ``endpoints`` (module doc), dilated by ``radius`` pixels."""
+    check_target(kind, radius, endpoints)
+    path = np.asarray(path, np.int64).reshape(-1, 2)
+    cells = np.asarray(vertices if kind == "vertex" else path, np.int64).reshape(-1, 2)
+    return cells_mask(_drop_ends(cells, path, endpoints), shape, radius)
+
+
+def label_masks(path: np.ndarray, vertices: np.ndarray, shape: tuple[int, int]) -> dict:
+    """The undilated ``(H, W)`` bool masks the heatmap metrics compare against
+    (:func:`vnrrt.model.metrics.heatmap_metrics`): ``path`` (all path cells), ``vertices``
+    (start and goal included), ``interior`` (vertices without start and goal) and
+    ``endpoints`` (start and goal)."""
+    path = np.asarray(path, np.int64).reshape(-1, 2)
+    vertices = np.asarray(vertices, np.int64).reshape(-1, 2)
+    return {
+        "path": cells_mask(path, shape),
+        "vertices": cells_mask(vertices, shape),
+        "interior": cells_mask(_drop_ends(vertices, path, "none"), shape),
+        "endpoints": cells_mask(path[[0, -1]], shape),
+    }

@@ -236,6 +236,54 @@ def _speed(c: dict | None) -> str:
     return f"{c['speedup']:.2f}x [{c['ci_low']:.2f}, {c['ci_high']:.2f}]"
 
 
+NETWORK_COLUMNS = [  # (header, metric, its uniform baseline or None)
+    ("interior recall", "interior_recall", None),
+    ("interior AP", "interior_ap", None),
+    ("path AP", "path_ap", None),
+    ("mass near interior (x uniform)", "mass_near_interior", "mass_near_interior_uniform"),
+    ("mass near path (x uniform)", "mass_near_path", "mass_near_path_uniform"),
+    ("mass on start/goal", "mass_on_endpoints", None),
+]
+
+
+def networks_table(networks: dict[str, dict]) -> str:
+    """The heatmap metrics of each network (``predict.json``: ``<set>/<metric>``) on the
+    test and named maps, as shares with multiples of a uniform map's where it has one."""
+    taus = sorted({k.rsplit("_tau", 1)[1] for m in networks.values() for k in m
+                   if "mass_near_interior_tau" in k})  # fmt: skip
+    cols = [*NETWORK_COLUMNS, *((f"interior, tau {t.replace('_', '.')} mask (x uniform)",
+            f"mass_near_interior_tau{t}", "mass_near_interior_uniform") for t in taus)]  # fmt: skip
+    lines = ["| network | maps | " + " | ".join(c[0] for c in cols) + " |",
+             "|" + "---|" * (len(cols) + 2)]  # fmt: skip
+    for net, m in networks.items():
+        for group in ("test", "named"):
+            vals = []
+            for _, key, base in cols:
+                v, u = m.get(f"{group}/{key}"), m.get(f"{group}/{base}") if base else None
+                vals.append("—" if v is None else _num(v) + (f" ({v / u:.1f}x)" if u else ""))
+            lines.append(f"| {net} | {group} | " + " | ".join(vals) + " |")
+    return "\n".join(lines)
+
+
+def networks_section(networks: dict[str, dict]) -> list[str]:
+    """The report's section on what the networks learnt (empty without metrics)."""
+    if not networks:
+        return []
+    return [
+        "## The networks' heatmaps",
+        "",
+        networks_table(networks),
+        "",
+        "Interior: the A* label's vertices other than start and goal (what a vertex sampler "
+        "should find; the start and goal are drawn in the input). Recall at probability 0.5 "
+        "within 3 px; AP over pixels against the interior vertices (path cells), each dilated "
+        "by 1 px, the start/goal disks left out of the interior AP; 'mass near': the share of "
+        "the heatmap within 3 px, beside a uniform map's; the tau columns after M-VNRRT*'s "
+        "mask (an image left empty counts as uniform).",
+        "",
+    ]
+
+
 def build_report(
     summary: dict,
     paper: dict,
@@ -243,8 +291,10 @@ def build_report(
     inference_ms: dict[str, float],
     sources: dict[str, str],
     scale: str,
+    networks: dict[str, dict] | None = None,
 ) -> str:
-    """The whole ``paper_comparison.md`` text."""
+    """The whole ``paper_comparison.md`` text; ``networks``: the heatmap metrics of
+    ``predict.json`` per network."""
     cols = paper["columns"]
     eps = summary["eps"]
     parts = [
@@ -316,6 +366,7 @@ def build_report(
             informed_section(summary),
         ]
     setup = ", ".join(f"{display_name(k)} {v:.2f} ms" for k, v in summary["setup_ms"].items())
+    parts += networks_section(networks or {})
     parts += [
         "## Planning time and network inference",
         "",

@@ -3,6 +3,7 @@
 
 * :class:`VertexRecall`: share of true vertices with a pixel of probability >= ``tau`` within
   ``radius`` pixels (over all vertices of all images).
+* :class:`MaskedAveragePrecision`: pixel AP against a label mask, some pixels ignored.
 * :class:`MassNear`: share of an image's predicted probability mass within ``radius`` pixels
   of a mask (the optimal path or its vertices), averaged over images. That is the chance that
   the heatmap sampler of VertexNet RRT* draws a pixel near the mask; ``uniform=True`` gives the
@@ -21,6 +22,8 @@ from torchmetrics import Metric, MetricCollection
 from torchmetrics.classification import BinaryF1Score
 
 from vnrrt.grid import disk
+
+LABEL_MASKS = ("vertices", "path", "interior", "endpoints")  # vnrrt.data.targets.label_masks
 
 
 def dilate(mask: Tensor, radius: float) -> Tensor:
@@ -78,15 +81,16 @@ class VertexRecall(Metric):
     higher_is_better = True
     full_state_update = False
 
-    def __init__(self, radius: float = 3.0, tau: float = 0.5, **kwargs) -> None:
+    def __init__(self, radius: float = 3.0, tau: float = 0.5, mask: str = "vertices",
+                 **kwargs) -> None:  # fmt: skip
         super().__init__(**kwargs)
-        self.radius, self.tau = radius, tau
+        self.radius, self.tau, self.mask = radius, tau, mask
         self.add_state("hits", torch.tensor(0.0), dist_reduce_fx="sum")
         self.add_state("total", torch.tensor(0.0), dist_reduce_fx="sum")
 
-    def update(self, preds: Tensor, vertices: Tensor) -> None:
+    def update(self, preds: Tensor, **masks: Tensor) -> None:
         near = dilate(preds >= self.tau, self.radius)  # (B, H, W)
-        vertices = vertices.bool()
+        vertices = masks[self.mask].bool()
         self.hits += (near & vertices).sum()
         self.total += vertices.sum()
 
@@ -133,25 +137,72 @@ class MassNear(Metric):
         return (self.share_sum / self.images.clamp_min(1.0)).float()
 
 
-def heatmap_metrics(radius: float = 3.0, tau: float = 0.5) -> dict[str, Metric]:
-    """``vertex_recall`` and the mass near the path and the vertices with their uniform
-    baselines (and the vertex share of the heatmap masked at ``tau``); updated with
-    ``update(preds=, vertices=, path=)``."""
-    return {
+class MaskedAveragePrecision(PixelAveragePrecision):
+    """Pixel AP of ``preds`` against positives ``mask`` dilated by ``radius`` px, with the
+    pixels of ``ignore`` (dilated by ``ignore_radius``) left out of the count: the interior
+    vertices' AP ignores the start and goal disks, which a vertex target marks too."""
+
+    def __init__(self, mask: str, radius: float = 1.0, ignore: str | None = None,
+                 ignore_radius: float = 0.0, thresholds: int = 101, **kw) -> None:  # fmt: skip
+        super().__init__(thresholds, **kw)
+        self.mask, self.radius = mask, radius
+        self.ignore, self.ignore_radius = ignore, ignore_radius
+
+    def update(self, preds: Tensor, **masks: Tensor) -> None:  # type: ignore[override]
+        target = dilate(masks[self.mask], self.radius)
+        keep = torch.ones_like(target)
+        if self.ignore is not None:
+            keep = ~dilate(masks[self.ignore], self.ignore_radius) | target
+        super().update(preds[keep], target[keep].long())
+
+
+def tau_key(name: str, tau: float) -> str:
+    """``name`` for the heatmap masked below ``tau``: ``mass_near_interior_tau0_9``."""
+    return f"{name}_tau{tau:g}".replace(".", "_")
+
+
+def heatmap_metrics(radius: float = 3.0, tau: float = 0.5, taus=(0.5, 0.9, 0.99),
+                    endpoint_radius: float = 3.0) -> dict[str, Metric]:  # fmt: skip
+    """The heatmap metrics, updated with ``update(preds=, vertices=, path=, interior=,
+    endpoints=)`` (``(B, H, W)`` bool masks; ``interior``: vertices without start and goal):
+
+    * ``vertex_recall`` / ``interior_recall``: vertices (all, interior) with a pixel of
+      probability >= ``tau`` within ``radius`` px;
+    * ``interior_ap``: pixel AP against the interior vertices (dilated by 1 px), the start
+      and goal disks (``endpoint_radius``) ignored; ``path_ap``: against the path (dilated
+      by 1 px), the same rule for the path network;
+    * ``mass_near_<mask>`` and ``..._uniform``: the share of the heatmap's mass within
+      ``radius`` px of the path, all vertices, the interior vertices, and a uniform map's;
+    * ``mass_on_endpoints``: the share within ``endpoint_radius`` of start and goal;
+    * ``mass_near_interior_tau<t>`` (``tau0_9`` for 0.9): the interior share after masking
+      below each ``t`` of ``taus`` (M-VNRRT*'s sampler; an image left empty counts as
+      uniform).
+    """
+    metrics = {
         "vertex_recall": VertexRecall(radius, tau),
+        "interior_recall": VertexRecall(radius, tau, mask="interior"),
+        "interior_ap": MaskedAveragePrecision("interior", 1.0, "endpoints", endpoint_radius),
+        "path_ap": MaskedAveragePrecision("path", 1.0),
         "mass_near_path": MassNear(radius, "path"),
         "mass_near_path_uniform": MassNear(radius, "path", uniform=True),
         "mass_near_vertex": MassNear(radius, "vertices"),
         "mass_near_vertex_uniform": MassNear(radius, "vertices", uniform=True),
         "mass_near_vertex_masked": MassNear(radius, "vertices", tau=tau),
+        "mass_near_interior": MassNear(radius, "interior"),
+        "mass_near_interior_uniform": MassNear(radius, "interior", uniform=True),
+        "mass_on_endpoints": MassNear(endpoint_radius, "endpoints"),
     }
+    for t in taus:
+        metrics[tau_key("mass_near_interior", t)] = MassNear(radius, "interior", tau=t)
+    return metrics
 
 
 def metric_collection(radius: float = 3.0, tau: float = 0.5, ap_thresholds: int = 101,
                       with_target: bool = True) -> MetricCollection:  # fmt: skip
-    """The metrics of one split, updated with ``update(preds=, target=, vertices=, path=)``:
-    pixel ``ap`` (binned over ``ap_thresholds``) and ``f1`` (at 0.5) against the training
-    target (unless ``with_target`` is False), and :func:`heatmap_metrics`."""
+    """The metrics of one split, updated with ``update(preds=, target=, vertices=, path=,
+    interior=, endpoints=)``: pixel ``ap`` (binned over ``ap_thresholds``) and ``f1`` (at 0.5)
+    against the training target (unless ``with_target`` is False), and
+    :func:`heatmap_metrics`."""
     metrics = heatmap_metrics(radius, tau)
     if with_target:
         metrics["ap"] = PixelAveragePrecision(ap_thresholds)

@@ -16,7 +16,7 @@ import lightning as L
 import torch
 from torch import Tensor, nn
 
-from vnrrt.model.metrics import metric_collection
+from vnrrt.model.metrics import LABEL_MASKS, metric_collection
 
 SPLITS = ("train", "val", "test")
 RECORD_KEY = "vnrrt"  # checkpoint entry holding the run's record (network config, target, ...)
@@ -32,7 +32,10 @@ class VertexNetModule(L.LightningModule):
     scheduler_interval: ``"step"`` or ``"epoch"``.
     metric_radius, metric_tau: "within r pixels" and the probability threshold of the
         metrics.
-    channels_last: use the channels-last memory format on CUDA (faster with bf16).
+    train_metrics_every: update the training metrics on every n-th batch only (they cost
+        about a quarter of a CPU step; loss is logged on every batch).
+    channels_last: use the channels-last memory format (faster on CUDA with bf16, and on
+        CPU: ``benchmarks/bench_cpu_training.py``).
     record: what the checkpoint must remember to rebuild and check the network (config of
         ``net``, target, rendering); stored under ``checkpoint["vnrrt"]``.
     """
@@ -40,8 +43,11 @@ class VertexNetModule(L.LightningModule):
     def __init__(self, net: nn.Module, loss: nn.Module, optimizer: Callable, scheduler=None,
                  scheduler_interval: str = "step", metric_radius: float = 3.0,
                  metric_tau: float = 0.5, channels_last: bool = True,
+                 train_metrics_every: int = 1,
                  record: dict[str, Any] | None = None) -> None:  # fmt: skip
         super().__init__()
+        if train_metrics_every < 1:
+            raise ValueError(f"train_metrics_every must be >= 1, got {train_metrics_every!r}")
         if scheduler_interval not in ("step", "epoch"):
             raise ValueError(f"scheduler_interval must be step or epoch: {scheduler_interval!r}")
         self.net, self.loss_fn = net, loss
@@ -50,17 +56,17 @@ class VertexNetModule(L.LightningModule):
         for split in SPLITS:  # train_metrics, val_metrics, test_metrics
             metrics = metric_collection(metric_radius, metric_tau).clone(prefix=f"{split}/")
             setattr(self, f"{split}_metrics", metrics)
-        self.channels_last = channels_last
+        self.channels_last, self.train_metrics_every = channels_last, train_metrics_every
         self.record = dict(record or {})
 
     def forward(self, image: Tensor) -> Tensor:
         """image ``(B, 3, H, W)`` -> logits ``(B, 2, H, W)``."""
-        if self.channels_last and image.is_cuda:
+        if self.channels_last:
             image = image.contiguous(memory_format=torch.channels_last)
         return self.net(image)
 
     def on_fit_start(self) -> None:
-        if self.channels_last and self.device.type == "cuda":
+        if self.channels_last:
             self.net.to(memory_format=torch.channels_last)
 
     def model_step(self, batch: dict[str, Tensor]) -> tuple[Tensor, Tensor]:
@@ -70,14 +76,15 @@ class VertexNetModule(L.LightningModule):
         probs = logits.float().softmax(dim=1)[:, 1]  # (B, H, W)
         return loss, probs
 
-    def _step(self, batch: dict[str, Tensor], split: str) -> dict[str, Tensor]:
+    def _step(self, batch: dict[str, Tensor], split: str, batch_idx: int = 0) -> dict[str, Tensor]:
         loss, probs = self.model_step(batch)
         metrics = getattr(self, f"{split}_metrics")
-        metrics.update(
-            preds=probs.detach(), target=batch["target"], vertices=batch["vertices"],
-            path=batch["path"],
-        )  # fmt: skip
         train = split == "train"
+        if not train or batch_idx % self.train_metrics_every == 0:
+            metrics.update(
+                preds=probs.detach(), target=batch["target"],
+                **{k: batch[k] for k in LABEL_MASKS},
+            )  # fmt: skip
         n = len(batch["image"])
         self.log(f"{split}/loss", loss, on_step=train, on_epoch=True, prog_bar=True,
                  batch_size=n, sync_dist=not train)  # fmt: skip
@@ -85,7 +92,7 @@ class VertexNetModule(L.LightningModule):
         return {"loss": loss, "probs": probs.detach()}
 
     def training_step(self, batch: dict[str, Tensor], batch_idx: int) -> dict[str, Tensor]:
-        return self._step(batch, "train")
+        return self._step(batch, "train", batch_idx)
 
     def validation_step(self, batch: dict[str, Tensor], batch_idx: int) -> dict[str, Tensor]:
         return self._step(batch, "val")

@@ -13,9 +13,9 @@ import time
 import numpy as np
 import torch
 
+from vnrrt.data.targets import label_masks
 from vnrrt.maps.render import render_instance
 from vnrrt.model.metrics import metric_collection
-from vnrrt.search import path_mask
 
 
 def inputs(instances, rows, render: dict) -> np.ndarray:
@@ -61,9 +61,9 @@ def heatmap_metrics(
     shape = (instances.size, instances.size)
     for k, i in enumerate(rows):
         inst = instances[int(i)]
+        masks = label_masks(inst.path, inst.vertices, shape)
         metrics.update(
             preds=torch.from_numpy(maps[k : k + 1].astype(np.float32)),
-            vertices=torch.from_numpy(path_mask(inst.vertices, shape))[None],
-            path=torch.from_numpy(path_mask(inst.path, shape))[None],
+            **{k: torch.from_numpy(v)[None] for k, v in masks.items()},
         )
     return {k: float(v) for k, v in metrics.compute().items()}

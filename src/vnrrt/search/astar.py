@@ -109,40 +109,88 @@ def _search_kernel(masks, src, dst, targets):
     return g.reshape(h, w)
 
 
+@njit(cache=True, inline="always")
+def _guide_distance(x, y, guide):
+    """Distance from point ``(x, y)`` to the polyline ``guide`` (K, 2), K >= 2."""
+    best = np.inf
+    for k in range(guide.shape[0] - 1):
+        ax, ay = guide[k, 0], guide[k, 1]
+        dx, dy = guide[k + 1, 0] - ax, guide[k + 1, 1] - ay
+        ll = dx * dx + dy * dy
+        t = 0.0 if ll == 0.0 else min(1.0, max(0.0, ((x - ax) * dx + (y - ay) * dy) / ll))
+        best = min(best, math.hypot(x - ax - t * dx, y - ay - t * dy))
+    return best
+
+
 @njit(cache=True)
-def descend_kernel(masks, dist, sx, sy, gx, gy, eps):
+def descend_kernel(masks, dist, sx, sy, gx, gy, eps, guide, tol):
     """Follow a distance field from ``(sx, sy)`` down to the goal; return ``(moves, ok)``.
 
     At each cell the candidates are the moves ``m`` with ``dist[next] + cost[m] ==
-    dist[cur]`` (within ``eps``): exactly the first moves of optimal paths. Ties keep the
-    previous move when it is a candidate, else take the candidate best aligned with the
-    straight line to the goal (largest cosine), then the lowest move code. ``moves`` is
-    (T,) int8 chain codes; ``ok`` is False if the field is inconsistent.
+    dist[cur]`` (within ``eps``): exactly the first moves of optimal paths, so every
+    tie-break gives an optimal path. With an empty ``guide`` (tie-break ``turns``), ties keep
+    the previous move when it is a candidate, else take the candidate best aligned with the
+    straight line to the goal (largest cosine), then the lowest move code. With a polyline
+    ``guide`` (K, 2) in pixels (tie-breaks ``line`` and ``exact``), ties take the candidate
+    that keeps the previous move while its next cell centre lies within ``tol`` px of it,
+    else the one whose next cell centre lies closest (then the previous move, then the
+    lowest code): ``tol`` 0 hugs the guide in a staircase, a larger one trades closeness
+    for fewer turns.
+    ``moves`` is (T,) int8 chain codes; ``ok`` is False if the field is inconsistent.
     """
     h, w = masks.shape
     moves = np.empty(h * w, np.int8)
     n, x, y, prev = 0, sx, sy, -1
+    guided = guide.shape[0] >= 2
     while x != gx or y != gy:
-        best, best_cos, bits = -1, -2.0, masks[y, x]
+        best, best_score, bits = -1, np.inf, masks[y, x]
         tx, ty = gx - x, gy - y
         norm = math.sqrt(tx * tx + ty * ty)
         for m in range(8):
             if not bits & (1 << m):
                 continue
-            if abs(dist[y + _DY[m], x + _DX[m]] + _COST[m] - dist[y, x]) > eps:
+            nx, ny = x + _DX[m], y + _DY[m]
+            if abs(dist[ny, nx] + _COST[m] - dist[y, x]) > eps:
                 continue
-            if m == prev:
+            if guided:
+                d = _guide_distance(nx + 0.5, ny + 0.5, guide)
+                if d <= tol:  # near enough: keep the direction, else the closest
+                    score = 1e-3 * d - (1.0 if m == prev else 0.0)
+                else:
+                    score = (d - tol) * 1.001 - (1e-9 if m == prev else 0.0)
+            elif m == prev:
                 best = m
                 break
-            c = (_DX[m] * tx + _DY[m] * ty) / (_COST[m] * norm)
-            if c > best_cos + 1e-12:
-                best, best_cos = m, c
+            else:
+                score = -(_DX[m] * tx + _DY[m] * ty) / (_COST[m] * norm)
+            if score < best_score - 1e-12:
+                best, best_score = m, score
         if best < 0 or n == h * w:
             return moves[:0], False
         moves[n] = best
         n += 1
         x, y, prev = x + _DX[best], y + _DY[best], best
     return moves[:n], True
+
+
+TIE_BREAKS = ("turns", "line", "exact")
+NO_GUIDE = np.zeros((0, 2))
+
+
+def guide_for(tie_break: str, grid: np.ndarray, start, goal) -> np.ndarray:
+    """The polyline ``(K, 2)`` a tie-break follows between the cells ``start`` and ``goal``:
+    none (``turns``), the straight segment between their centres (``line``) or the exact
+    continuous optimum's turning points (``exact``)."""
+    if tie_break not in TIE_BREAKS:
+        raise ValueError(f"unknown tie-break {tie_break!r}; known: {TIE_BREAKS}")
+    if tie_break == "turns":
+        return NO_GUIDE
+    centres = np.array([start, goal], np.float64) + 0.5
+    if tie_break == "line":
+        return centres
+    from vnrrt.search.anyangle import any_angle_path
+
+    return any_angle_path(grid, centres[0], centres[1])[0]
 
 
 def moves_to_path(start: tuple[int, int], moves: np.ndarray) -> np.ndarray:
@@ -165,7 +213,8 @@ def path_length(path: np.ndarray) -> float:
     return (len(steps) - n_diag) + n_diag * math.sqrt(2.0)
 
 
-def astar(grid: np.ndarray, start, goal) -> tuple[np.ndarray, float]:
+def astar(grid: np.ndarray, start, goal, tie_break: str = "turns",
+          tolerance: float = 0.0) -> tuple[np.ndarray, float]:  # fmt: skip
     """Optimal 8-connected path from ``start`` to ``goal`` (graph rules in the module doc).
 
     Args:
@@ -175,7 +224,9 @@ def astar(grid: np.ndarray, start, goal) -> tuple[np.ndarray, float]:
     Returns:
         ``(path, length)``: ``path`` ``(T+1, 2)`` int64 cells (x, y) from start to goal
         inclusive; ``length`` its octile length (float, pixel units). Among equally short
-        paths the one with fewest turns is preferred (see :func:`descend_kernel`).
+        paths ``tie_break`` chooses (:func:`descend_kernel`): ``'turns'`` fewest turns,
+        ``'line'`` closest to the straight start-goal line, ``'exact'`` closest to the exact
+        continuous optimum, the last two within ``tolerance`` px.
 
     Raises:
         GridError: malformed grid, or start/goal outside the grid or on an obstacle.
@@ -189,7 +240,8 @@ def astar(grid: np.ndarray, start, goal) -> tuple[np.ndarray, float]:
     masks = move_masks(occ)
     empty = np.zeros(0, np.int64)
     g = _search_kernel(masks, gy * occ.shape[1] + gx, sy * occ.shape[1] + sx, empty)
-    moves = descend(masks, g, (sx, sy), (gx, gy))
+    guide = guide_for(tie_break, occ, (sx, sy), (gx, gy))
+    moves = descend(masks, g, (sx, sy), (gx, gy), guide, tolerance)
     return moves_to_path((sx, sy), moves), float(g[sy, sx])
 
 
@@ -206,17 +258,22 @@ def distance_field(masks: np.ndarray, goal, targets: np.ndarray | None = None) -
     return _search_kernel(masks, int(goal[1]) * w + int(goal[0]), -1, tg[:, 1] * w + tg[:, 0])
 
 
-def descend(masks: np.ndarray, dist: np.ndarray, start, goal) -> np.ndarray:
+def descend(
+    masks: np.ndarray, dist: np.ndarray, start, goal, guide=NO_GUIDE, tol: float = 0.0
+) -> np.ndarray:
     """Chain codes ``(T,)`` int8 of an optimal path from ``start`` to the goal of ``dist``.
 
     ``masks`` is :func:`move_masks` of the grid; ``dist`` comes from
     :func:`distance_field` for ``goal`` with ``start`` among its targets. Tie-breaking
-    (fewest turns first) is described in :func:`descend_kernel`.
+    (fewest turns first, or closest to ``guide`` within ``tol`` px: :func:`guide_for`) is
+    described in :func:`descend_kernel`.
     """
     sx, sy, gx, gy = int(start[0]), int(start[1]), int(goal[0]), int(goal[1])
     if not np.isfinite(dist[sy, sx]):
         raise NoPathError(f"no path from start {(sx, sy)} to goal {(gx, gy)}: not connected")
-    moves, ok = descend_kernel(masks, dist, sx, sy, gx, gy, EPS)
+    moves, ok = descend_kernel(
+        masks, dist, sx, sy, gx, gy, EPS, np.asarray(guide, np.float64), float(tol)
+    )
     if not ok:
         raise RuntimeError(f"distance field inconsistent at start {(sx, sy)}; was it a target?")
     return moves

@@ -31,7 +31,7 @@ LOGGER_CALLBACKS = ("learning_rate_monitor", "prediction_figures")  # need an ML
 
 
 def network_spec(cfg: DictConfig, network: str) -> DictConfig:
-    """``networks.<network>`` (target, radius, resume); ``KeyError`` lists the known ones."""
+    """``networks.<network>`` (target, endpoints, resume); ``KeyError`` lists the known ones."""
     if network not in cfg.networks:
         raise KeyError(f"unknown network {network!r}; configured: {sorted(cfg.networks)}")
     return cfg.networks[network]
@@ -50,7 +50,22 @@ def fingerprint(cfg: DictConfig, network: str) -> str:
     }
     spec = OmegaConf.to_container(network_spec(cfg, network), resolve=True)
     doc["network"] = {k: v for k, v in spec.items() if k != "resume"}
-    return hashlib.sha256(json.dumps(doc, sort_keys=True).encode()).hexdigest()
+    places = {str(v): f"<paths.{k}>" for k, v in (cfg.get("paths") or {}).items()}
+    return hashlib.sha256(json.dumps(_unplaced(doc, places), sort_keys=True).encode()).hexdigest()
+
+
+def _unplaced(doc, places: dict[str, str]):
+    """``doc`` with every string under a ``paths`` folder written relative to its key, so
+    that the same run in another folder has the same fingerprint."""
+    if isinstance(doc, dict):
+        return {k: _unplaced(v, places) for k, v in doc.items()}
+    if isinstance(doc, list):
+        return [_unplaced(v, places) for v in doc]
+    if isinstance(doc, str):
+        for folder, key in sorted(places.items(), key=lambda kv: -len(kv[0])):
+            if folder and doc.startswith(folder):
+                return key + doc[len(folder) :]
+    return doc
 
 
 def make_record(cfg: DictConfig, network: str, net) -> dict:
@@ -59,7 +74,11 @@ def make_record(cfg: DictConfig, network: str, net) -> dict:
     return {
         "network": network,
         "net": OmegaConf.to_container(cfg.model.net, resolve=True),
-        "target": {"kind": spec.target, "radius": float(spec.radius)},
+        "target": {
+            "kind": spec.target,
+            "endpoints": spec.endpoints,
+            "radius": float(dm.target_radius),
+        },
         "render": {"marker_radius": float(dm.marker_radius), "normalize": dm.normalize},
         "describe": net.describe() if hasattr(net, "describe") else {},
         "fingerprint": fingerprint(cfg, network),
@@ -133,6 +152,19 @@ def one_handler() -> None:
         lg.propagate = True
 
 
+def fix_threads(threads: int | None) -> int:
+    """Set torch's intra-op thread count (None: keep torch's default, the cores); returns
+    the count in use. Float sums may differ between thread counts, so a run's metrics
+    record it: equal checkpoints need equal counts."""
+    import torch
+
+    if threads is not None:
+        if int(threads) < 1:
+            raise ValueError(f"train.threads must be >= 1 or null, got {threads!r}")
+        torch.set_num_threads(int(threads))
+    return torch.get_num_threads()
+
+
 def run_train(cfg: DictConfig, network: str) -> dict:
     """Stage ``train@<network>``: train ``network`` as configured (module doc); returns and
     writes its metrics."""
@@ -146,8 +178,11 @@ def run_train(cfg: DictConfig, network: str) -> dict:
     from vnrrt.training.train import fit, resolve_precision
 
     spec = network_spec(cfg, network)
-    L.seed_everything(int(cfg.seed), workers=True)
-    datamodule = instantiate(cfg.train.datamodule, target=spec.target, target_radius=spec.radius)
+    threads = fix_threads(cfg.train.get("threads"))
+    L.seed_everything(int(cfg.train.get("seed", cfg.seed)), workers=True)
+    datamodule = instantiate(
+        cfg.train.datamodule, target=spec.target, target_endpoints=spec.endpoints
+    )
     net, loss = instantiate(cfg.model.net), instantiate(cfg.model.loss)
     record = make_record(cfg, network, net)
     make_module = instantiate(cfg.train.module, _partial_=True)
@@ -180,6 +215,7 @@ def run_train(cfg: DictConfig, network: str) -> dict:
         from vnrrt.model.checkpoint import write_checksum
 
         metrics["checkpoint_sha256"] = write_checksum(out)
+        metrics["threads"] = threads
         write_json(metrics_file, metrics)
         shutil.rmtree(Path(cfg.paths.models) / "checkpoints" / network, ignore_errors=True)
     return metrics

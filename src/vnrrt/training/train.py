@@ -6,6 +6,7 @@ the objects from it.
 
 from __future__ import annotations
 
+import io
 import logging
 import os
 import time
@@ -27,12 +28,29 @@ def resolve_precision(precision: str | int, accelerator: str) -> str | int:
     return "bf16-mixed" if gpu else "32-true"
 
 
+VOLATILE_CALLBACKS = ("Timer", "ModelCheckpoint")  # wall-clock time; paths of last.ckpt
+
+
 def save_final(trainer: L.Trainer, out: Path) -> None:
-    """Write the final checkpoint to ``out`` atomically (every rank calls, rank 0 writes)."""
+    """Write the final checkpoint to ``out`` atomically (every rank calls, rank 0 writes).
+
+    Its bytes depend only on the training: the state of the callbacks in
+    :data:`VOLATILE_CALLBACKS` (elapsed wall-clock time, the path of the deleted
+    ``last.ckpt``) is left out, so two identical runs write identical files. Weights,
+    optimizer, scheduler and loop states are kept: training can go on from it.
+    """
     tmp = out.with_name(f"{out.name}.tmp-{os.getpid()}")
     trainer.save_checkpoint(tmp)
-    if trainer.is_global_zero:
-        os.replace(tmp, out)
+    if not trainer.is_global_zero:
+        return
+    ckpt = torch.load(tmp, map_location="cpu", weights_only=True)
+    kept = {k: v for k, v in ckpt.get("callbacks", {}).items()
+            if not k.startswith(VOLATILE_CALLBACKS)}  # fmt: skip
+    ckpt["callbacks"] = kept
+    buffer = io.BytesIO()  # an in-memory file: the archive's inner name is fixed ("archive")
+    torch.save(ckpt, buffer)
+    tmp.write_bytes(buffer.getvalue())
+    os.replace(tmp, out)
 
 
 def summary(trainer: L.Trainer, tested: dict, seconds: float, batch_size: int) -> dict:

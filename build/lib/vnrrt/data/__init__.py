@@ -1,1 +1,0 @@
-"""Sharded datasets: the shard format, building shards, reading them, the manifest."""

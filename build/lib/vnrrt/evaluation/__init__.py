@@ -1,1 +1,0 @@
-"""Evaluation of the planners: trial statistics and the report against the paper."""

@@ -1,1 +1,0 @@
-"""Floor maps: random generation (OpenCV shapes), the five named maps, RGB rendering."""

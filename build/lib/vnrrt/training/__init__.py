@@ -1,1 +1,0 @@
-"""Training of VertexNet and the NRRT* network: Lightning, Hydra-instantiated objects, MLflow."""
