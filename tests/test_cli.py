@@ -92,7 +92,7 @@ def test_start_equal_to_goal_is_a_zero_length_plan(map_npy, capsys):
     ("extra", "message"),
     [
         (["--start", "39.5,8.5", "--goal", "72.5,8.5"], "obstacle"),
-        (["--start", "8.5,8.5", "--goal", "72.5,8.5", "--planner", "vnrrt_star"], "heatmap"),
+        (["--start", "8.5,8.5", "--goal", "72.5,8.5", "--planner", "vnrrt_star"], "--checkpoint"),
         (["--start", "8.5,8.5", "--goal", "72.5,8.5", "--set", "etta=3"], "unknown"),
         (["--goal", "72.5,8.5"], "--start"),
         (["--start", "8.5,8.5", "--goal", "72.5,8.5", "--set", "max_iterations=1e12"],
@@ -141,3 +141,22 @@ def test_version_and_module_entry_point_with_plain_help():
     help_text = subprocess.run([sys.executable, "-m", "vnrrt", "--help"], capture_output=True,
                                text=True, check=True).stdout  # fmt: skip
     assert "vnrrt plan" in help_text and "``" not in help_text and ":func:" not in help_text
+
+
+def test_an_edited_shard_beside_its_manifest_is_refused(tmp_path, capsys):
+    """A shard rebuilt (valid, but not the one the manifest records) is refused by the CLI
+    and by the stage that reads shards for the evaluation, naming the shard."""
+    from vnrrt.data.manifest import ShardError, build_manifest, verified_files
+    from vnrrt.data.shards import shard_file
+
+    shards = tmp_path / "shards"
+    build_shard(shard_file(shards, 0), 0, 0, 2, DataConfig(), LabelsConfig(), workers=1)
+    build_manifest(shards, [0], tmp_path / "manifest.json")
+    assert main(["plan", "--map", str(shard_file(shards, 0)), "--instance", "0"]) == 0
+    build_shard(shard_file(shards, 0), 0, 1, 2, DataConfig(), LabelsConfig(), workers=1)
+    capsys.readouterr()
+    assert main(["plan", "--map", str(shard_file(shards, 0)), "--instance", "0"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "shard_0.npz does not match its checksum" in err and "\n" not in err
+    with pytest.raises(ShardError, match="does not match its checksum"):
+        verified_files(shards, tmp_path / "manifest.json", [0])  # as run_instances calls it

@@ -242,6 +242,9 @@ def run_plan(args: argparse.Namespace) -> int:
     inst = load_instance(args.map, args.instance)
     start, goal = _endpoints(args, inst)
     heatmap = _heatmap(args, inst, start, goal)
+    if heatmap is None and args.planner != "rrt_star":
+        raise UsageError(f"--planner {args.planner} samples a heatmap: give --heatmap FILE "
+                         "or --checkpoint CKPT (e.g. models/quick/vertexnet.ckpt)")  # fmt: skip
     if args.out is not None and args.out.is_dir():
         raise UsageError(f"--out {args.out} is a directory; give a .png file name")
     result = plan(inst["grid"], start, goal, args.planner, heatmap=heatmap, tau=args.tau,
