@@ -20,7 +20,7 @@ import time
 import numpy as np
 
 from vnrrt.grid import GridError, as_occupancy, as_point
-from vnrrt.planners import core, spatial
+from vnrrt.planners import core
 from vnrrt.planners.collision import point_free, polyline_length, segment_free
 from vnrrt.planners.config import PLANNERS, PlannerConfig
 from vnrrt.planners.reference import reference_length as compute_reference
@@ -225,13 +225,8 @@ def _timed(occ, start, goal, planner, sampler, target, milestones, seed, cfg, ke
 def _start(run: _Run, occ, p: core.Params, stops, straight_first: bool) -> None:
     """The root at the start; the goal joins it when it is within reach and visible (any
     distance with ``straight_first``: a free straight segment is the optimum)."""
-    tree, c = run.tree, run.counters
-    core.add_node(tree, 0, -1, p.sx, p.sy, 0.0)
-    spatial.insert(tree.head, tree.bnext, p.bucket, 0, p.sx, p.sy)
-    c.nodes[0] = 1
     first = p._replace(goal_radius=math.inf) if straight_first else p
-    core.connect_goal(occ, tree, c, run.scratch.stack, first, 0)
-    core.record(c, tree, run.trace, stops)
+    core.plant(occ, run.tree, run.counters, run.scratch.stack, run.trace, first, stops)
 
 
 def _drive(run, occ, draws, p, rng, stops, target, cfg, t0):

@@ -297,6 +297,17 @@ def record(counters, tree, trace, milestones):
 
 
 @njit(cache=True)
+def plant(occ, tree, counters, stack, trace, p, milestones):
+    """The root at the start, the goal joined to it when ``p`` allows (:func:`connect_goal`)
+    and the trace started: one compiled call, so a free straight segment costs microseconds."""
+    add_node(tree, 0, -1, p.sx, p.sy, 0.0)
+    spatial.insert(tree.head, tree.bnext, p.bucket, 0, p.sx, p.sy)
+    counters.nodes[0] = 1
+    connect_goal(occ, tree, counters, stack, p, 0)
+    record(counters, tree, trace, milestones)
+
+
+@njit(cache=True)
 def near_radius(n, p):
     """Near radius for a tree of ``n`` nodes: ``min(gamma sqrt(log n / n), eta)``, or the
     fixed ``radius`` when ``gamma <= 0``."""
