@@ -10,6 +10,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.colors import ListedColormap, PowerNorm
+from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
 from vnrrt.io import atomic_write_bytes
 
@@ -105,3 +106,16 @@ def plot_heatmap(ax, heatmap, grid=None, start=None, goal=None, title="", vmax: 
     mark_endpoints(ax, start, goal)
     frame_axes(ax, (h, w), title)
     return image
+
+
+def log_ticks(axis) -> None:
+    """A log scale on ``axis`` (an x or y axis, after plotting) with plain-number labels that
+    always shows some: powers of ten when the data span 1.5 decades or more, 1-2-5 steps down
+    to half a decade, every integer multiple below (a narrow span may hold no power of ten)."""
+    getattr(axis.axes, f"set_{axis.axis_name}scale")("log")
+    lo, hi = sorted(axis.get_data_interval())
+    decades = float(np.log10(hi / lo)) if 0 < lo <= hi < np.inf else 2.0  # unknown: wide
+    subs = (1.0,) if decades >= 1.5 else (1.0, 2.0, 5.0) if decades >= 0.5 else range(1, 10)
+    axis.set_major_locator(LogLocator(base=10, subs=subs, numticks=6))
+    axis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+    axis.set_minor_formatter(NullFormatter())

@@ -7,10 +7,9 @@ from pathlib import Path
 
 import matplotlib.pyplot as plt
 import numpy as np
-from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
 from vnrrt.names import STOP_NAMES, display_name, map_set_title, sort_keys
-from vnrrt.viz.common import plot_floor_map, plot_heatmap, save_figure
+from vnrrt.viz.common import log_ticks, plot_floor_map, plot_heatmap, save_figure
 
 HEATMAP_TITLES = {"nrrtnet": "(c) NRRT* network", "vertexnet": "(d) VertexNet"}
 
@@ -29,7 +28,9 @@ def heatmaps_figure(grids, paths, vertices, starts, goals, heatmaps: dict, title
         ),
     )
     n, cols = len(grids), 2 + len(names)
-    fig, axes = plt.subplots(n, cols, figsize=(2.6 * cols + 0.6, 2.7 * n), squeeze=False)
+    fig, axes = plt.subplots(
+        n, cols, figsize=(2.6 * cols + 0.6, 2.9 * n), squeeze=False, layout="constrained"
+    )
     image = None
     for i in range(n):
         row = titles[i] if titles else f"instance {i + 1}"
@@ -55,7 +56,7 @@ def heatmaps_figure(grids, paths, vertices, starts, goals, heatmaps: dict, title
                 axes[i, 2 + j], heat, grids[i], starts[i], goals[i], HEATMAP_TITLES.get(name, name)
             )
     if image is not None:
-        bar = fig.colorbar(image, ax=axes[:, 2:].ravel().tolist(), fraction=0.025, pad=0.02)
+        bar = fig.colorbar(image, ax=axes[:, 2:].ravel().tolist(), shrink=0.9, aspect=30)
         bar.set_label("predicted probability (square-root scale)")
     return fig
 
@@ -137,10 +138,7 @@ def convergence_figure(curves, names: dict[str, str] | None = None):
                 rows = sub[sub["planner"] == key].sort_values("factor", ascending=False)
                 (line,) = ax.plot(rows["median_time"] * 1e3, rows["factor"], "o-", ms=3)
                 handles.setdefault(display_name(key), line)
-            ax.set_xscale("log")
-            ax.xaxis.set_major_locator(LogLocator(base=10, numticks=5))
-            ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
-            ax.xaxis.set_minor_formatter(NullFormatter())
+            log_ticks(ax.xaxis)
             ax.set_title(map_set_title(map_set, (names or {}).get(map_set)), fontsize=9)
             ax.set_xlabel("median time (ms)", fontsize=8)
             ax.tick_params(labelsize=7)

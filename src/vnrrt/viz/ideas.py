@@ -8,10 +8,9 @@ from pathlib import Path
 import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
-from matplotlib.ticker import FuncFormatter, NullFormatter
 
 from vnrrt.names import STOP_NAMES, display_name
-from vnrrt.viz.common import save_figure
+from vnrrt.viz.common import log_ticks, save_figure
 
 IDEA_NAMES = {"oracle_path": "path oracle", "oracle_vertex": "vertex oracle"}
 
@@ -48,11 +47,8 @@ def quality_figure(curves: pd.DataFrame, networks: pd.DataFrame, metric: str = "
                 textcoords="offset points",
             )
         ax.axhline(1.0, color="grey", lw=0.8)
-        ax.set_xscale("log")
-        ax.set_yscale("log")
-        for axis in (ax.xaxis, ax.yaxis):
-            axis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
-            axis.set_minor_formatter(NullFormatter())
+        log_ticks(ax.xaxis)
+        log_ticks(ax.yaxis)
         ax.set_xlabel("heatmap mass within 3 px of its target")
         ax.set_title(STOP_NAMES[stop], fontsize=9)
     axes[0, 0].set_ylabel(f"speed-up over RRT* ({metric.replace('time_to_stop', 'time')})")

@@ -12,10 +12,16 @@ from vnrrt.viz.common import plot_floor_map, save_figure
 
 
 def save_named_maps(shard_path: str | Path, out_png: str | Path) -> None:
-    """Fig. 4 from a named-maps shard: each map with its A* path, vertices, start and goal."""
+    """Fig. 4 from a named-maps shard file, saved as a PNG (:func:`named_maps_figure`)."""
     from vnrrt.data.reader import Shard
 
-    shard = Shard(shard_path)
+    save_figure(named_maps_figure(Shard(shard_path)), out_png)
+
+
+def named_maps_figure(shard):
+    """Fig. 4 from a named-maps :class:`~vnrrt.data.reader.Shard`: one panel per instance
+    with its map, A* path, vertices, start and goal, titled ``Map k: name`` and its A*
+    length. Returns the figure."""
     names = shard.meta.get("names", [str(i) for i in range(shard.n_maps)])
     fig, axes = plt.subplots(1, shard.n_instances, figsize=(3.2 * shard.n_instances, 3.5))
     for i, ax in enumerate(np.atleast_1d(axes)):
@@ -32,4 +38,4 @@ def save_named_maps(shard_path: str | Path, out_png: str | Path) -> None:
             title,
         )
     fig.tight_layout()
-    save_figure(fig, out_png)
+    return fig
