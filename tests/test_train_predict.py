@@ -117,7 +117,7 @@ def test_bad_parts_and_missing_heatmaps_are_named(predicted, tmp_path):
 def test_the_command_line_predicts_what_the_stage_predicted(predicted, tmp_path, capsys):
     """`vnrrt predict` and `vnrrt plan --checkpoint` on a named map give the pipeline's
     heatmap for that instance (row 2 of the parts: named map 3)."""
-    from vnrrt.cli import main
+    from vnrrt.cli import load_heatmap, main
 
     cfg, _, _ = predicted
     ckpt = str(Path(cfg.paths.models) / "vertexnet.ckpt")
@@ -134,7 +134,18 @@ def test_the_command_line_predicts_what_the_stage_predicted(predicted, tmp_path,
     rc = main(["plan", "--map", named, "--instance", "2", "--planner", "vnrrt_star",
                "--checkpoint", ckpt])  # fmt: skip
     assert rc == 0 and "vnrrt_star: success=True" in capsys.readouterr().out
-    heat_file = part_file(cfg.paths.heatmaps, 0)
-    rc = main(["plan", "--map", named, "--instance", "2", "--planner", "vnrrt_star",
-               "--heatmap", str(heat_file), "--network", "vertexnet"])  # fmt: skip
-    assert rc == 0
+    # A pipeline heatmap file is read at the --map instance's key (-1, 2), in whichever part
+    # holds it; a part without it, or a --row of another instance, is refused.
+    files = [part_file(cfg.paths.heatmaps, k) for k in cfg.predict.parts]
+    holds = [((read_heatmaps(f)["keys"] == (-1, 2)).all(axis=1)).any() for f in files]
+    right, wrong = files[holds.index(True)], files[holds.index(False)]
+    got = load_heatmap(right, (-1, 2), "vertexnet")
+    np.testing.assert_array_equal(got, want.astype(np.float16).astype(np.float64))
+    plan = ["plan", "--map", named, "--instance", "2", "--planner", "vnrrt_star", "--network",
+            "vertexnet", "--heatmap"]  # fmt: skip
+    assert main([*plan, str(right)]) == 0
+    assert main([*plan, str(wrong)]) == 2
+    assert "holds no heatmap of instance (-1, 2)" in capsys.readouterr().err
+    other = int(np.flatnonzero(~(read_heatmaps(right)["keys"] == (-1, 2)).all(axis=1))[0])
+    assert main([*plan, str(right), "--row", str(other)]) == 2
+    assert "not the --map instance (-1, 2)" in capsys.readouterr().err

@@ -78,7 +78,8 @@ def _shard_instance(path: Path, instance: str | None) -> dict:
     inst = shard.instance(index)
     s, g = inst["start"], inst["goal"]
     return {"grid": shard.grid(inst["map_index"]), "start": (s[0] + 0.5, s[1] + 0.5),
-            "goal": (g[0] + 0.5, g[1] + 0.5), "astar": inst["length"], "index": index}  # fmt: skip
+            "goal": (g[0] + 0.5, g[1] + 0.5), "astar": inst["length"], "index": index,
+            "key": (int(shard.meta.get("shard", -1)), index)}  # fmt: skip
 
 
 def _verify_against_manifest(path: Path) -> None:
@@ -112,9 +113,16 @@ def load_instance(path: Path, instance: str | None) -> dict:
     raise UsageError(f"unsupported map file {path}: use .npy, .png or a shard .npz")
 
 
-def load_heatmap(path: Path, instance: int | None = None, network: str | None = None) -> np.ndarray:
+def load_heatmap(
+    path: Path,
+    key: tuple[int, int] | None = None,
+    network: str | None = None,
+    row: int | None = None,
+) -> np.ndarray:
     """Heatmap ``(H, W)`` float64 from ``.npy``, a grayscale ``.png`` (scaled to [0, 1]) or a
-    pipeline heatmap file (``.npz``: row ``instance`` of ``network``)."""
+    pipeline heatmap file (``.npz``: ``network``'s heatmap of the instance ``key`` = (shard
+    id, instance index; -1 for the named maps), or of ``row`` when the map has no key; both
+    given must agree, so that a heatmap of another instance is never used)."""
     if not path.is_file():
         raise UsageError(f"heatmap file {path} not found")
     if path.suffix == ".npy":
@@ -129,10 +137,26 @@ def load_heatmap(path: Path, instance: int | None = None, network: str | None = 
         nets = sorted(heat["maps"])
         if network not in heat["maps"]:
             raise UsageError(f"give --network, one of {nets} in {path}")
-        if instance is None or not 0 <= instance < len(heat["keys"]):
-            raise UsageError(f"--instance must index the {len(heat['keys'])} rows of {path}")
-        return heat["maps"][network][instance].astype(np.float64)
+        return heat["maps"][network][_heat_row(heat["keys"], path, key, row)].astype(np.float64)
     raise UsageError(f"unsupported heatmap file {path}: use .npy, .png or a pipeline .npz")
+
+
+def _heat_row(keys: np.ndarray, path: Path, key, row: int | None) -> int:
+    """The row of a heatmap file's ``keys`` (N, 2) for instance ``key`` and/or ``row``."""
+    if row is not None and not 0 <= row < len(keys):
+        raise UsageError(f"--row {row} is not one of the {len(keys)} rows of {path}")
+    if key is None:
+        if row is None:
+            raise UsageError(f"give --row: which of the {len(keys)} heatmaps of {path}")
+        return row
+    hits = np.flatnonzero((keys == np.asarray(key)).all(axis=1))
+    if not len(hits):
+        raise UsageError(f"{path} holds no heatmap of instance {tuple(key)} (shard, index) of "
+                         "--map: use the heatmap file (part) that covers it")  # fmt: skip
+    if row is not None and row != hits[0]:
+        raise UsageError(f"--row {row} of {path} is instance {tuple(keys[row])}, not the "
+                         f"--map instance {tuple(key)} (row {hits[0]})")  # fmt: skip
+    return int(hits[0])
 
 
 def _overrides(pairs: list[str]) -> dict:
@@ -205,7 +229,7 @@ def add_plan_command(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--planner", choices=PLANNERS, default="rrt_star")
     p.add_argument("--heatmap", type=Path, help="sampling heatmap .npy, .png or pipeline .npz")
     p.add_argument("--network", help="network of a pipeline heatmap .npz (vertexnet, nrrtnet)")
-    p.add_argument("--row", type=int, help="row of a pipeline heatmap .npz (default: --instance)")
+    p.add_argument("--row", type=int, help="row of a pipeline .npz heatmap (default: --instance's)")
     p.add_argument("--checkpoint", help="predict the heatmap with this network checkpoint")
     p.add_argument("--tau", type=float, help="mask threshold of m_vnrrt_star, in (0, 1]")
     p.add_argument("--stop", choices=("initial", "optimal"), default="initial")
@@ -227,8 +251,7 @@ def _heatmap(args, inst: dict, start, goal) -> np.ndarray | None:
         cells = point_to_cell(np.array([start, goal]))
         return heatmap(args.checkpoint, inst["grid"], tuple(cells[0]), tuple(cells[1]))
     if args.heatmap:
-        row = args.row if args.row is not None else inst.get("index")
-        return load_heatmap(args.heatmap, row, args.network)
+        return load_heatmap(args.heatmap, inst.get("key"), args.network, args.row)
     return None
 
 
