@@ -123,8 +123,17 @@ def test_a_training_run_is_recorded_in_mlflow(small_data, tmp_path, monkeypatch)
     inst = shard.instance(0)
     grid = shard.grid(inst["map_index"])
     from_ckpt = heatmap(tmp_path / "models" / "vertexnet.ckpt", grid, inst["start"], inst["goal"])
-    from vnrrt.predict.api import Model
+    from vnrrt.model.checkpoint import load_network
+    from vnrrt.predict.api import Model, load_model
 
     from_mlflow = heatmap(Model(model.eval(), {}), grid, inst["start"], inst["goal"])
     np.testing.assert_allclose(from_mlflow, from_ckpt, atol=1e-6)
+    # ... and by URI through vnrrt.predict, with the rendering the network was trained with
+    monkeypatch.setenv("MLFLOW_TRACKING_URI", f"sqlite:///{tmp_path}/mlflow.db")
+    for uri in (f"runs:/{run.info.run_id}/model", "models:/vnrrt-vertexnet/1"):
+        loaded = load_model(uri)
+        assert loaded.render == load_network(tmp_path / "models" / "vertexnet.ckpt")[1]["render"]
+        np.testing.assert_allclose(
+            heatmap(uri, grid, inst["start"], inst["goal"]), from_ckpt, atol=1e-6
+        )
     assert not (tmp_path / "models" / "checkpoints" / "vertexnet").exists()  # cleaned up

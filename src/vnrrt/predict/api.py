@@ -48,7 +48,9 @@ def _from_mlflow(uri: str) -> Model:
     net = mlflow.pytorch.load_model(uri, map_location="cpu")
     if not isinstance(net, torch.nn.Module):  # a torch.export program (pt2 format)
         net = net.module()
-    return Model(net.eval(), {"render": dict(DEFAULT_RENDER), "source": uri})
+    # the input rendering the network was trained with (logged as model metadata)
+    render = (mlflow.models.get_model_info(uri).metadata or {}).get("render", DEFAULT_RENDER)
+    return Model(net.eval(), {"render": dict(render), "source": uri})
 
 
 @functools.lru_cache(maxsize=8)

@@ -234,7 +234,7 @@ def log_model(cfg: DictConfig, network: str, checkpoint: Path, logger, datamodul
 
     from vnrrt.model.checkpoint import load_network
 
-    net, _ = load_network(checkpoint, network)
+    net, record = load_network(checkpoint, network)
     example = datamodule.datasets["val"][0]["image"][None].numpy()  # (1, 3, S, S) float32
     mlflow.set_tracking_uri(tracking.tracking_uri(cfg.logger.uri))
     with mlflow.start_run(run_id=logger.run_id):
@@ -246,4 +246,5 @@ def log_model(cfg: DictConfig, network: str, checkpoint: Path, logger, datamodul
             input_example=example,
             registered_model_name=registered,
             serialization_format="pickle",
+            metadata={"render": dict(record["render"])},  # how to draw its input image
         )
