@@ -76,6 +76,10 @@ def test_a_resumed_run_ends_where_an_uninterrupted_one_does(small_data, tmp_path
     assert read_checkpoint(last)["global_step"] == 2
     resumed = train(cut, "vertexnet")  # the same stage again, nothing said about resuming
     assert resumed["steps"] == full["steps"] == 4 and resumed["epochs"] == 2
+    assert (resumed["resumed_from_step"], full["resumed_from_step"]) == (2, 0)
+    # the throughput counts this run's 2 steps only (batch size from the config)
+    batch = cut.train.datamodule.batch_size
+    assert resumed["train_images_per_s"] * resumed["fit_seconds"] == pytest.approx(2 * batch)
     want = read_checkpoint(tmp_path / "full" / "models" / "vertexnet.ckpt")["state_dict"]
     got = read_checkpoint(tmp_path / "cut" / "models" / "vertexnet.ckpt")["state_dict"]
     for key, value in want.items():

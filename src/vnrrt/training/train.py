@@ -53,19 +53,31 @@ def save_final(trainer: L.Trainer, out: Path) -> None:
     os.replace(tmp, out)
 
 
-def summary(trainer: L.Trainer, tested: dict, seconds: float, batch_size: int) -> dict:
-    """Metrics of a run: final val metrics, test metrics, steps, time, throughput."""
+def summary(
+    trainer: L.Trainer, tested: dict, seconds: float, batch_size: int, first_step: int = 0
+) -> dict:
+    """Metrics of a run: final val metrics, test metrics, steps, time, throughput.
+    ``first_step``: the step a resumed run started from; ``fit_seconds`` and the throughput
+    are those of this run's steps only."""
     val = {k: float(v) for k, v in trainer.callback_metrics.items() if k.startswith("val/")}
-    images = trainer.global_step * batch_size * trainer.world_size
+    per_step = batch_size * trainer.world_size
     return {
         **val,
         **{k: float(v) for k, v in tested.items()},
         "epochs": trainer.current_epoch,
         "steps": trainer.global_step,
-        "train_images": images,
+        "resumed_from_step": first_step,
+        "train_images": trainer.global_step * per_step,
         "fit_seconds": seconds,
-        "train_images_per_s": images / max(seconds, 1e-9),
+        "train_images_per_s": (trainer.global_step - first_step) * per_step / max(seconds, 1e-9),
     }
+
+
+def resumed_step(checkpoint: Path | None) -> int:
+    """The global step a Lightning checkpoint was saved at (0 for none)."""
+    if checkpoint is None:
+        return 0
+    return int(torch.load(checkpoint, map_location="cpu", weights_only=True)["global_step"])
 
 
 def fit(
@@ -79,13 +91,14 @@ def fit(
 ) -> dict:
     """Train ``module`` (from ``resume``, a Lightning checkpoint, if given), write the final
     checkpoint to ``out``, test it and write the metrics to ``metrics_file``; returns them."""
+    first_step = resumed_step(resume)  # before the run overwrites its last.ckpt
     start = time.perf_counter()
     trainer.fit(module, datamodule=datamodule, ckpt_path=None if resume is None else str(resume))
     seconds = time.perf_counter() - start
     out.parent.mkdir(parents=True, exist_ok=True)
     save_final(trainer, out)
     tested = trainer.test(module, datamodule=datamodule, verbose=False)[0]
-    metrics = summary(trainer, tested, seconds, batch_size)
+    metrics = summary(trainer, tested, seconds, batch_size, first_step)
     if trainer.is_global_zero:
         write_json(metrics_file, metrics)
         log.info("%s: %s", out.stem, {k: round(v, 4) for k, v in metrics.items()})
