@@ -20,26 +20,11 @@ from vnrrt.data.manifest import build_manifest
 from vnrrt.data.shards import shard_file
 from vnrrt.evaluation.instances import Instances
 from vnrrt.evaluation.stage import run_evaluate, run_instances, run_report, run_trials_part
-from vnrrt.evaluation.table import TableError, merge_parts, read_table
+from vnrrt.evaluation.table import SEEDED_COLUMNS, TableError, merge_parts, read_table
 from vnrrt.maps.config import DataConfig
 from vnrrt.search import path_mask
 
 NETS = (("vertexnet", "vertex"), ("nrrtnet", "path"))
-# Columns that depend on the seeds only (not on timing): equal whatever the split.
-DETERMINISTIC = [
-    "seq",
-    "instance",
-    "key",
-    "trial",
-    "seed",
-    "stop",
-    "success",
-    "cost",
-    "iterations",
-    "tree_size",
-    "collision_checks",
-    "reference_length",
-]
 
 
 def view(cfg, stage: str, repo: Path):
@@ -221,7 +206,7 @@ def test_the_table_does_not_depend_on_the_split(cfg, repo, tmp_path):
     one.eval.parts, one.paths.trials = [0], str(tmp_path / "one")
     run_trials_part(view(one, "trials@0", repo), 0)
     whole = merge_parts(one.paths.trials, [0], len(split))
-    pd.testing.assert_frame_equal(whole[DETERMINISTIC], split[DETERMINISTIC])
+    pd.testing.assert_frame_equal(whole[list(SEEDED_COLUMNS)], split[list(SEEDED_COLUMNS)])
 
 
 def test_missing_repeated_or_foreign_parts_and_heatmaps_are_refused(cfg, repo, tmp_path):

@@ -22,7 +22,7 @@ from vnrrt.data.config import LabelsConfig
 from vnrrt.data.heatmaps import read_heatmaps
 from vnrrt.data.manifest import verify_manifest
 from vnrrt.data.shards import shard_file
-from vnrrt.evaluation.table import merge_parts
+from vnrrt.evaluation.table import SEEDED_COLUMNS, merge_parts
 from vnrrt.maps.config import DataConfig
 
 SHARDS = Path("data/smoke/shards")
@@ -207,22 +207,6 @@ def test_an_evaluation_only_experiment_reruns_only_the_evaluation(workdir):
     assert "m_vnrrt_star@0.7" in set(table["key"])
 
 
-# Trial columns that depend on seeds and inputs only, not on timing or the machine's load.
-DETERMINISTIC = [
-    "seq",
-    "key",
-    "trial",
-    "seed",
-    "stop",
-    "success",
-    "cost",
-    "iterations",
-    "tree_size",
-    "collision_checks",
-    "reference_length",
-]
-
-
 def test_predict_and_trial_parts_as_multirun_jobs_write_the_stage_files(workdir, request):
     """The predict@<k> and trials@<k> parts again, as Hydra multirun shard jobs (joblib;
     trials on the local SLURM cluster where it runs). They write the stages' files: heatmaps
@@ -275,7 +259,7 @@ def test_predict_and_trial_parts_as_multirun_jobs_write_the_stage_files(workdir,
         launcher = ["hydra/launcher=local"]
     run([*job, "+stage=trials", *launcher], workdir, **env)
     got = merge_parts(trials, [0, 1], n)
-    pd.testing.assert_frame_equal(got[DETERMINISTIC], stage_trials[DETERMINISTIC])
+    pd.testing.assert_frame_equal(got[list(SEEDED_COLUMNS)], stage_trials[list(SEEDED_COLUMNS)])
     run(["dvc", "commit", "-f", "predict", "trials"], workdir)
     out = run(["dvc", "repro", "evaluate"], workdir)
     for stage in ("predict@0", "predict@1", "trials@0", "trials@1"):

@@ -1,7 +1,7 @@
 """Everything the report says, computed once from the merged trial table (stage
 ``evaluate``): per-cell summaries, paired speed-ups, the paper's claims with verdicts and
-convergence curves. The result is plain JSON-able data (``reports/eval/summary.json``);
-:mod:`vnrrt.evaluation.report` only renders it.
+convergence curves. The result is plain JSON-able data (``paths.summary``,
+``data/<scale>/summary.json``); :mod:`vnrrt.evaluation.report` only renders it.
 """
 
 from __future__ import annotations

@@ -72,6 +72,10 @@ class TrialRow:
 FIELDS = tuple(f for f in dataclasses.fields(TrialRow) if f.name != "convergence")
 CONVERGENCE_COLUMNS = tuple(convergence_column(f) for f in CONVERGENCE_FACTORS)
 COLUMNS = tuple(f.name for f in FIELDS) + CONVERGENCE_COLUMNS
+# Columns that measure time, and so change from run to run; every other column depends on
+# the inputs and seeds only (a re-run, or another split into parts, reproduces it exactly).
+TIMING_COLUMNS = ("time_to_first", "time_to_stop", "setup_time", *CONVERGENCE_COLUMNS)
+SEEDED_COLUMNS = tuple(c for c in COLUMNS if c not in TIMING_COLUMNS)
 _KINDS = {int: "int64", float: "float64", str: "object", bool: "bool"}
 DTYPES = {
     f.name: _KINDS[{"int": int, "float": float, "str": str, "bool": bool}[f.type]] for f in FIELDS
