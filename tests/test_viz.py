@@ -183,7 +183,11 @@ def test_quality_curve_one_panel_per_stop_with_networks_as_stars():
         columns=["stop", "idea", "configuration", "q", "heat_mass", "metric", *SPEEDUP],
     )
     nets = pd.DataFrame(
-        [("optimal", "vnrrt_star[vertexnet]", "iterations", 0.05, 1.3, 1.1, 1.5)],
+        [
+            ("optimal", "vnrrt_star[vertexnet]", "iterations", 0.05, 1.3, 1.1, 1.5),
+            ("optimal", "m_vnrrt_star@0.5[vertexnet]", "iterations", 0.05, 1.31, 1.1, 1.5),
+            ("optimal", "vnrrt_star[vertexnet]+informed", "iterations", 0.05, 6.0, 5.0, 7.0),
+        ],
         columns=["stop", "configuration", "metric", "heat_mass", *SPEEDUP],
     )
     fig = quality_figure(curves, nets)
@@ -202,9 +206,13 @@ def test_quality_curve_one_panel_per_stop_with_networks_as_stars():
         "VNRRT*, vertex oracle",
     ]
     stars = [line for line in panels[0].get_lines() if line.get_marker() == "*"]
-    assert [(s.get_xdata()[0], s.get_ydata()[0]) for s in stars] == [(0.05, 1.3)]
+    # the informed network is not placed on curves of plain samplers
+    assert [(s.get_xdata()[0], s.get_ydata()[0]) for s in stars] == [(0.05, 1.3), (0.05, 1.31)]
     assert not [line for line in panels[1].get_lines() if line.get_marker() == "*"]
-    assert "VNRRT* [vertexnet]" in [t.get_text() for t in panels[0].texts]
+    labels = {t.get_text(): t for t in panels[0].texts}
+    assert set(labels) == {"VNRRT* [vertexnet]", "M-VNRRT* τ=0.5 [vertexnet]"}
+    offsets = {t.xyann[1] for t in labels.values()}
+    assert len(offsets) == 2  # two stars at one place: their labels stacked, not overlaid
     assert "whiskers: 95% CI" in fig._suptitle.get_text()
 
 

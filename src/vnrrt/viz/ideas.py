@@ -9,7 +9,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 
-from vnrrt.names import STOP_NAMES, display_name
+from vnrrt.names import INFORMED, STOP_NAMES, display_name
 from vnrrt.viz.common import log_ticks, save_figure
 
 IDEA_NAMES = {"oracle_path": "path oracle", "oracle_vertex": "vertex oracle"}
@@ -37,13 +37,19 @@ def quality_figure(curves: pd.DataFrame, networks: pd.DataFrame, metric: str = "
                 label=label,
             )
         nets = networks[(networks["stop"] == stop) & (networks["metric"] == metric)]
+        # the curves are plain (not informed) samplers: informed networks are not on them
+        nets = nets[~nets["configuration"].str.endswith(INFORMED)].sort_values("speedup")
+        placed: list[float] = []  # log10 heights of the labels so far: close ones stacked
         for _, row in nets.iterrows():
             ax.plot(row["heat_mass"], row["speedup"], "*", ms=12, color="black")
+            y = float(np.log10(row["speedup"]))
+            lift = sum(abs(y - other) < 0.05 for other in placed)
+            placed.append(y)
             ax.annotate(
                 display_name(row["configuration"]),
                 (row["heat_mass"], row["speedup"]),
                 fontsize=7,
-                xytext=(4, 4),
+                xytext=(4, 4 + 9 * lift),
                 textcoords="offset points",
             )
         ax.axhline(1.0, color="grey", lw=0.8)
