@@ -40,7 +40,7 @@ repro: $(STAMP)  ## run the whole pipeline (dvc repro) at the default scale
 	$(BIN)/dvc repro
 
 CPU_REPORTS := reports/cpu
-repro-cpu: $(STAMP)  ## the CPU study scale (~2 h on 2 cores): both networks at train.seed 1, then the whole pipeline at seed 0; reports copied to reports/cpu/
+repro-cpu: $(STAMP)  ## the CPU study scale (~80 min on 2 cores): both networks at train.seed 1, then the whole pipeline at seed 0; reports copied to reports/cpu/
 	$(BIN)/dvc exp run -S scale=cpu -S train.seed=1 predict_metrics
 	rm -rf $(CPU_REPORTS) && mkdir -p $(CPU_REPORTS)/seed1
 	cp reports/metrics/train_*.json reports/metrics/predict.json $(CPU_REPORTS)/seed1/
