@@ -45,13 +45,23 @@ def _ignore_sigint() -> None:
 
 
 def _terminate(pool: ProcessPoolExecutor) -> None:
-    """Cancel pending work, kill the workers and reap them."""
+    """Cancel pending work, kill the workers and reap them, and let the pool's manager
+    thread end (the interpreter's exit joins it): it must not wait for the call queue's
+    feeder (which may block on a pipe no worker reads) nor for the rest of a result that a
+    killed worker was sending."""
+    # shutdown() drops the pool's references to these: take them first
     procs = list((getattr(pool, "_processes", None) or {}).values())
+    calls = getattr(pool, "_call_queue", None)
+    results = getattr(pool, "_result_queue", None)
+    if calls is not None:
+        calls.cancel_join_thread()
     pool.shutdown(wait=False, cancel_futures=True)
     for p in procs:
         p.kill()
     for p in procs:
         p.join(timeout=5)
+    if results is not None:  # a worker killed while sending leaves a partial message that
+        results._writer.close()  # the manager thread waits on: with no writer left, EOF
 
 
 def parallel_map(
