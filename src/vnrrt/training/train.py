@@ -77,7 +77,9 @@ def resumed_step(checkpoint: Path | None) -> int:
     """The global step a Lightning checkpoint was saved at (0 for none)."""
     if checkpoint is None:
         return 0
-    return int(torch.load(checkpoint, map_location="cpu", weights_only=True)["global_step"])
+    from vnrrt.model.checkpoint import read_checkpoint
+
+    return int(read_checkpoint(checkpoint)["global_step"])
 
 
 def fit(
