@@ -93,6 +93,17 @@ def test_the_straight_segment_first_is_the_optimum_at_once():
     s, g = (3.5, 4.5), (96.5, 91.5)
     r = plan(grid, s, g, stop="optimal", straight_first=True, reference_length=math.dist(s, g))
     assert r.success and r.iterations == 0 and r.cost == pytest.approx(math.dist(s, g))
+    assert r.time_to_first == r.time_to_stop and r.tree_size == 2
+    np.testing.assert_allclose(r.path, [s, g])
+    tree = plan(grid, s, g, straight_first=True, keep_tree=True)
+    np.testing.assert_allclose(tree.tree_points, [s, g])
+    assert list(tree.tree_parents) == [-1, 0]
+    # a stop bound below the straight segment cannot be met: the search runs to its budget
+    short = plan(grid, s, g, stop="optimal", straight_first=True, reference_length=10.0,
+                 max_iterations=300, seed=0)  # fmt: skip
+    assert not short.success and short.stop_reason == "max_iterations"
+    assert short.time_to_first < short.time_to_stop
+    assert short.cost == pytest.approx(math.dist(s, g))
     blocked = grid.copy()
     blocked[40:60, 40:60] = 1
     r2 = plan(blocked, s, g, stop="initial", straight_first=True, seed=0)
