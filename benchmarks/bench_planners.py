@@ -177,12 +177,13 @@ def report(per_map: dict, names: list[str], limit: float) -> None:
     omplers = [n for n in names if n.startswith("ompl")]
     for key, label in (("first", "first solution"), ("optimal", "<= 1.01 x exact optimum")):
         print(f"\nmedian ms to the {label}, per map (ratio = best OMPL / ours-best)")
-        print(f"{'map':<16}" + "".join(f"{n:>20}" for n in names) + f"{'ratio':>9}")
+        wide = max(map(len, names)) + 2
+        print(f"{'map':<16}" + "".join(f"{n:>{wide}}" for n in names) + f"{'ratio':>9}")
         ratios = []
         for name, runs in per_map.items():
             meds = {n: median_time(runs[n], key, limit) for n in names}
             cells = "".join(
-                f"{('>=' if c else '') + f'{1e3 * m:.3g}':>20}" for m, c in meds.values()
+                f"{('>=' if c else '') + f'{1e3 * m:.3g}':>{wide}}" for m, c in meds.values()
             )
             best = min(meds[n][0] for n in omplers)
             ratio = best / max(meds["ours-best"][0], 1e-9)
@@ -192,7 +193,7 @@ def report(per_map: dict, names: list[str], limit: float) -> None:
             n: np.median([median_time(per_map[m][n], key, limit)[0] for m in per_map])
             for n in names
         }
-        print(f"{'median of maps':<16}" + "".join(f"{1e3 * overall[n]:>20.3g}" for n in names))
+        print(f"{'median of maps':<16}" + "".join(f"{1e3 * overall[n]:>{wide}.3g}" for n in names))
         best = min(overall[n] for n in omplers) / overall["ours-best"]
         print(
             f"ours-best vs the best OMPL planner: median over maps {best:.1f}x; per map: "

@@ -197,6 +197,14 @@ def test_report_stage_writes_report_figures_metrics_and_nested_mlflow_runs(cfg, 
     keys = paper | {k + "+informed" for k in paper}  # the informed variants: their own runs
     assert set(children["tags.planner"]) == keys
     assert children["metrics.optimal/random/success_rate"].notna().all()
+    params = children.set_index("tags.planner")
+    for key in keys:  # each run's params name its configuration (independent of the key code)
+        base = key.removesuffix("+informed")
+        planner, _, tau = base.partition("@")
+        row = params.loc[key]
+        assert row["params.planner"] == planner and row["params.tau"] == (tau or "none")
+        assert row["params.informed"] == str(key.endswith("+informed")).lower()
+        assert row["params.source"] == cfg.eval.sources.get(planner, "uniform")
 
 
 def test_the_table_does_not_depend_on_the_split(cfg, repo, tmp_path):

@@ -13,6 +13,7 @@ from omegaconf import DictConfig, OmegaConf
 from vnrrt import tracking
 from vnrrt.config import section
 from vnrrt.evaluation.config import EvalConfig
+from vnrrt.evaluation.protocol import PlannerSpec, parse_key
 from vnrrt.io import read_json
 
 
@@ -68,19 +69,23 @@ def log_evaluation(
             with mlflow.start_run(
                 experiment_id=exp, run_name=key, nested=True, tags={**tags, "planner": key}
             ):
-                planner, _, tau = key.partition("[")[0].partition("@")
-                mlflow.log_params(
-                    {
-                        "planner": planner,
-                        "tau": tau or "none",
-                        "source": ev.sources.get(planner, "uniform"),
-                    }
-                )
+                mlflow.log_params(_config_params(parse_key(key, ev.sources)))
                 mlflow.log_metrics(_config_metrics(summary, key))
         for path in artifacts:
             if Path(path).is_file():
                 mlflow.log_artifact(str(path))
         return parent.info.run_id
+
+
+def _config_params(spec: PlannerSpec) -> dict[str, str]:
+    """The MLflow params of one configuration: planner, mask threshold, heatmap source
+    (``uniform`` for RRT*) and informed sampling."""
+    return {
+        "planner": spec.planner,
+        "tau": "none" if spec.tau is None else f"{spec.tau:g}",
+        "source": spec.source or "uniform",
+        "informed": str(spec.informed).lower(),
+    }
 
 
 def config_dict(node) -> dict:

@@ -214,10 +214,11 @@ def _timed(occ, start, goal, planner, sampler, target, milestones, seed, cfg, ke
     t0 = time.perf_counter()
     straight = cfg.straight_first and segment_free(occ, p.sx, p.sy, p.gx, p.gy)
     found = time.perf_counter() - t0
-    capacity = 2 if straight else min(cfg.max_iterations + 2, FIRST_CAPACITY)  # root and goal
+    answered = straight and (target is None or math.dist(start, goal) <= target)
+    capacity = 2 if answered else min(cfg.max_iterations + 2, FIRST_CAPACITY)  # root and goal
     run = _Run(capacity, occ.shape, p.bucket, cfg.trace_capacity)
-    _start(run, occ, p, stops, cfg.straight_first)
-    if straight and _solved(run, target):  # known after one segment test (see _solved_clock)
+    _start(run, occ, p, stops, straight)
+    if answered and _solved(run, target):  # known after one segment test (see _solved_clock)
         clock = _solved_clock(found)
     else:
         clock = functools.partial(_since, t0)
@@ -250,10 +251,10 @@ def _solved(run: _Run, target: float | None) -> bool:
     return g >= 0 and (target is None or run.tree.cost[g] <= target)
 
 
-def _start(run: _Run, occ, p: core.Params, stops, straight_first: bool) -> None:
-    """The root at the start; the goal joins it when it is within reach and visible (any
-    distance with ``straight_first``: a free straight segment is the optimum)."""
-    first = p._replace(goal_radius=math.inf) if straight_first else p
+def _start(run: _Run, occ, p: core.Params, stops, straight: bool) -> None:
+    """The root at the start; the goal joins it when it is within reach and visible, or at
+    any distance when the straight segment is known to be free (``straight``: the optimum)."""
+    first = p._replace(goal_radius=math.inf) if straight else p
     core.plant(occ, run.tree, run.counters, run.scratch.stack, run.trace, first, stops)
 
 

@@ -332,13 +332,14 @@ def grow(occ, tree, scratch, counters, trace, rng, draws, milestones, p, n_iter)
     """Run up to ``n_iter`` RRT* iterations (module doc) on ``tree``.
 
     Returns :data:`MILESTONE_HIT` as soon as the best cost passes a milestone (so the
-    caller can time it), :data:`TREE_FULL` when no room is left for a node and the goal,
-    else :data:`RUNNING`. ``occ`` is the ``(H, W)`` uint8 grid, ``rng`` the sampler state.
+    caller can time it), :data:`TREE_FULL` when no room is left for a node (and the goal,
+    while unconnected), else :data:`RUNNING`. ``occ`` is the ``(H, W)`` uint8 grid, ``rng``
+    the sampler state.
     """
     h, w = occ.shape
     for _ in range(n_iter):
         new = counters.nodes[0]
-        if new + 2 > tree.pts.shape[0]:
+        if new + (1 if counters.goal[0] >= 0 else 2) > tree.pts.shape[0]:
             return TREE_FULL
         counters.iters[0] += 1
         c_best = best_cost(tree, counters)

