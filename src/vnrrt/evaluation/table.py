@@ -47,7 +47,7 @@ class TrialRow:
     trial: int
     seed: int
     success: bool  # stop rule met within the budgets
-    stop_reason: str  # solved | max_iterations | max_seconds | tree_full
+    stop_reason: str  # solved | max_iterations | max_seconds
     fallback_uniform: bool  # the heatmap had no weight left (M-VNRRT* above tau): uniform
     reference_length: float  # A* length (initial, optimal) or exact optimum (optimal_any_angle)
     cost: float  # length of the best path found (inf: none)

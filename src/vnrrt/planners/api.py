@@ -277,8 +277,8 @@ def _drive(run, occ, draws, p, rng, stops, target, cfg, clock):
         if _solved(run, target):
             return "solved", times, iters
         if status == core.TREE_FULL:
-            if run.capacity >= cfg.max_iterations + 2:
-                return "tree_full", times, iters
+            if run.capacity >= cfg.max_iterations + 2:  # root, goal and a node per iteration
+                raise RuntimeError(f"tree of {run.capacity} nodes full before the budget")
             run.enlarge(min(2 * run.capacity, cfg.max_iterations + 2))
         if c.iters[0] >= cfg.max_iterations:
             return "max_iterations", times, iters

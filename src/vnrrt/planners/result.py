@@ -32,7 +32,7 @@ class PlanResult:
         planner: ``'rrt_star'``, ``'nrrt_star'``, ``'vnrrt_star'`` or ``'m_vnrrt_star'``.
         success: the stop rule was met (``initial``: a solution exists; ``optimal``:
             ``cost <= target_cost``). False after a budget was hit.
-        stop_reason: ``'solved'``, ``'max_iterations'``, ``'max_seconds'`` or ``'tree_full'``.
+        stop_reason: ``'solved'``, ``'max_iterations'`` or ``'max_seconds'``.
         path: ``(K, 2)`` float64 best path found, start to goal (``(0, 2)`` if none); it
             is returned even when ``success`` is False.
         cost: polyline length of ``path`` (``inf`` if none).
