@@ -157,7 +157,7 @@ def test_nodes_added_after_a_solution_can_improve_it_and_the_best_path_is_kept(p
     assert on_tree.all()
 
 
-def test_uninformed_runs_add_nodes_outside_the_ellipse():
+def test_uninformed_runs_add_nodes_that_cannot_improve_the_first_solution():
     """The check above is not empty: without informed skipping the same run adds nodes
     that cannot improve the first solution."""
     fm = named_map("u_trap", 200)
@@ -213,8 +213,8 @@ def test_the_straight_segment_first_is_the_optimum_at_once():
 @pytest.mark.parametrize("straight_first", [False, True])
 @pytest.mark.parametrize("budget", [1, 2, 5, 40])
 def test_an_unreachable_bound_runs_exactly_the_iteration_budget(budget, straight_first):
-    """With the goal joined at once (straight segment, any-distance goal radius) and every
-    iteration adding a node, the tree still has room for the whole budget."""
+    """With the goal joined at once (straight segment, any-distance goal radius) and nearly
+    every iteration adding a node (an empty map), the tree has room for the whole budget."""
     grid = np.zeros((100, 100), np.uint8)
     r = plan(grid, (3.5, 4.5), (96.5, 91.5), stop="optimal", reference_length=1.0,
              goal_radius=math.inf, straight_first=straight_first,
