@@ -1,6 +1,6 @@
 """DVC stage ideas: the oracle study and regime sweep merged, sampling_ideas.md, figures."""
 
-from vnrrt.evaluation.stage import run_ideas
+from vnrrt.evaluation.sampling_ideas.stage import run_ideas
 from vnrrt.stage_cli import stage_main
 
 if __name__ == "__main__":

@@ -1,6 +1,6 @@
 """DVC stage regime@<k>: part k of the planner-regime sweep."""
 
-from vnrrt.evaluation.stage import run_regime_part
+from vnrrt.evaluation.sampling_ideas.stage import run_regime_part
 from vnrrt.stage_cli import stage_main
 
 if __name__ == "__main__":

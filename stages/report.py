@@ -1,6 +1,6 @@
 """DVC stage report: paper_comparison.md, figures, headline metrics, MLflow runs."""
 
-from vnrrt.evaluation.stage import run_report
+from vnrrt.evaluation.paper_comparison.stage import run_report
 from vnrrt.stage_cli import stage_main
 
 if __name__ == "__main__":

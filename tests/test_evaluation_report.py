@@ -4,10 +4,17 @@ the paper's rows, display names and plain-text cells."""
 import numpy as np
 import pandas as pd
 
-from vnrrt.evaluation.analysis import analyze, load_paper_tables
-from vnrrt.evaluation.report import build_report, cell
+from vnrrt.evaluation.paper_comparison.report import (
+    MetricSettings,
+    build_report,
+    cell,
+    networks_section,
+)
+from vnrrt.evaluation.paper_comparison.summary import analyze
+from vnrrt.evaluation.paper_tables import load_paper_tables
 from vnrrt.evaluation.table import COLUMNS, conform
-from vnrrt.names import display_name, sort_keys
+
+METRICS = MetricSettings(radius=3.0, tau=0.5, ap_radius=1.0, endpoint_radius=3.0)
 
 
 def synthetic_trials() -> pd.DataFrame:
@@ -84,7 +91,7 @@ def test_cells_show_censoring_and_fallbacks():
 
 def test_report_on_a_synthetic_table(repo):
     paper = load_paper_tables(repo / "reports/paper/tables.yaml")
-    summary = analyze(synthetic_trials(), paper, eps=0.01, n_boot=300)
+    summary = analyze(synthetic_trials(), paper, eps=0.01, n_boot=300, level=0.95)
     optima = {"map_1": {"astar": 110.0, "exact": 100.0, "taut": 101.0}}
     text = build_report(
         summary,
@@ -93,6 +100,8 @@ def test_report_on_a_synthetic_table(repo):
         {"vertexnet": 15.0, "nrrtnet": 14.0},
         {"nrrt_star": "nrrtnet", "vnrrt_star": "vertexnet", "m_vnrrt_star@0.5": "vertexnet"},
         "synthetic",
+        {},
+        METRICS,
     )
     assert "| NRRT* | paper | 36.48±37.57" in text and "<br>" not in text
     assert "fallback" in text and ">=" in text  # M-VNRRT*'s censored failures are shown
@@ -117,28 +126,13 @@ def test_report_on_a_synthetic_table(repo):
     assert 1.6 < vn["speedup"] < 2.4 and vn["instances"] == 20 and vn["clusters"] == 10
 
 
-def test_display_names_and_order():
-    assert display_name("m_vnrrt_star@0.5") == "M-VNRRT* τ=0.5"
-    assert display_name("vnrrt_star[oracle_vertex]") == "VNRRT* [oracle_vertex]"
-    keys = ["m_vnrrt_star@0.9", "vnrrt_star", "rrt_star", "m_vnrrt_star@0.5", "nrrt_star"]
-    assert sort_keys(keys) == [
-        "rrt_star",
-        "nrrt_star",
-        "vnrrt_star",
-        "m_vnrrt_star@0.5",
-        "m_vnrrt_star@0.9",
-    ]
-
-
 def test_networks_table_shows_shares_and_multiples_of_uniform():
-    from vnrrt.evaluation.report import networks_section
-
     m = {"test/interior_recall": 0.25, "test/interior_ap": 0.12,
          "test/mass_near_interior": 0.2, "test/mass_near_interior_uniform": 0.01,
          "test/mass_near_interior_tau0_9": 0.05}  # fmt: skip
-    text = "\n".join(networks_section({"vertexnet": m}))
+    text = "\n".join(networks_section({"vertexnet": m}, METRICS))
     row = next(ln for ln in text.splitlines() if ln.startswith("| vertexnet | test |"))
     cells = [c.strip() for c in row.strip("|").split("|")]
     assert cells[2:5] == ["0.25", "0.12", "—"]
     assert cells[5] == "0.2 (20.0x)" and cells[-1] == "0.05 (5.0x)"
-    assert "tau 0.9 mask" in text and networks_section({}) == []
+    assert "tau 0.9 mask" in text and networks_section({}, METRICS) == []

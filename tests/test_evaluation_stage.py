@@ -16,10 +16,11 @@ from vnrrt.data.build import build_shard
 from vnrrt.data.build_named import build_named_maps
 from vnrrt.data.config import LabelsConfig
 from vnrrt.data.heatmaps import part_file, part_rows, write_heatmaps
+from vnrrt.data.instances import Instances
 from vnrrt.data.manifest import build_manifest
 from vnrrt.data.shards import shard_file
-from vnrrt.evaluation.instances import Instances
-from vnrrt.evaluation.stage import run_evaluate, run_instances, run_report, run_trials_part
+from vnrrt.evaluation.paper_comparison.stage import run_evaluate, run_report
+from vnrrt.evaluation.stage import run_instances, run_trials_part
 from vnrrt.evaluation.table import SEEDED_COLUMNS, TableError, merge_parts, read_table
 from vnrrt.maps.config import DataConfig
 from vnrrt.search import path_mask
@@ -133,22 +134,24 @@ def test_report_stage_writes_report_figures_metrics_and_nested_mlflow_runs(cfg, 
     import mlflow
 
     (Path(cfg.paths.metrics)).mkdir(parents=True, exist_ok=True)
-    (Path(cfg.paths.metrics) / "predict.json").write_text(
-        json.dumps(
-            {
-                "vertexnet": {
-                    "ms_per_map": 15.0,
-                    "test/mass_near_interior": 0.1,
-                    "test/mass_near_interior_uniform": 0.02,
-                    "test/interior_ap": 0.12,
-                },
-                "nrrtnet": {
-                    "ms_per_map": 14.0,
-                    "test/mass_near_path": 0.2,
-                    "test/mass_near_path_uniform": 0.05,
-                },
-            }
-        )
+    settings = {"radius": 3.0, "tau": 0.5, "ap_radius": 1.0, "endpoint_radius": 3.0}
+    networks = {
+        "vertexnet": {
+            "target": "vertex",
+            "ms_per_map": 15.0,
+            "test/mass_near_interior": 0.1,
+            "test/mass_near_interior_uniform": 0.02,
+            "test/interior_ap": 0.12,
+        },
+        "nrrtnet": {
+            "target": "path",
+            "ms_per_map": 14.0,
+            "test/mass_near_path": 0.2,
+            "test/mass_near_path_uniform": 0.05,
+        },
+    }
+    Path(cfg.paths.predict_metrics).write_text(
+        json.dumps({"settings": settings, "networks": networks})
     )
     run_report(view(cfg, "report", repo))
     text = Path(cfg.paths.report).read_text()

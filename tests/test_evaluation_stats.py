@@ -7,7 +7,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from vnrrt.evaluation.analysis import load_paper_tables
+from vnrrt.evaluation.paper_tables import load_paper_tables
 from vnrrt.evaluation.stats import (
     bootstrap_means,
     compare,

@@ -7,9 +7,10 @@ import time
 import numpy as np
 import pytest
 
+from vnrrt.data.instances import EvalInstance
 from vnrrt.evaluation import trials as trials_module
-from vnrrt.evaluation.instances import EvalInstance
-from vnrrt.evaluation.protocol import PlannerSpec, trial_seed
+from vnrrt.evaluation.keys import ConfigKey
+from vnrrt.evaluation.protocol import trial_seed
 from vnrrt.evaluation.table import COLUMNS, CONVERGENCE_COLUMNS
 from vnrrt.evaluation.trials import run_trials
 from vnrrt.planners import PlannerConfig, plan
@@ -44,9 +45,9 @@ def wall_instance(map_set="map_1", index=0) -> EvalInstance:
 
 
 SPECS = [
-    PlannerSpec("rrt_star"),
-    PlannerSpec("nrrt_star", source="path"),
-    PlannerSpec("m_vnrrt_star", 0.5, "vertex"),
+    ConfigKey("rrt_star"),
+    ConfigKey("nrrt_star", source="path"),
+    ConfigKey("m_vnrrt_star", 0.5, "vertex"),
 ]
 
 

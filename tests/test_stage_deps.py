@@ -32,10 +32,12 @@ def test_the_closure_sees_function_level_imports_and_hydra_targets():
     assert "src/vnrrt/viz/training.py" in train  # imported inside a callback method
     assert "src/vnrrt/viz/evaluation.py" not in train
     trials = {str(p) for p in closure(STAGES["trials"], declared_params("trials"))}
-    assert "src/vnrrt/evaluation/report.py" not in trials  # a wording change re-runs no trial
+    assert (
+        "src/vnrrt/evaluation/paper_comparison/report.py" not in trials
+    )  # a wording change re-runs no trial
     assert "src/vnrrt/evaluation/stats.py" not in trials
     oracle = {str(p) for p in closure(STAGES["oracle"], declared_params("oracle"))}
-    assert "src/vnrrt/evaluation/oracle.py" in oracle  # imported by a helper the entry calls
+    assert "src/vnrrt/evaluation/sources.py" in oracle  # imported by a helper the entry calls
     assert "src/vnrrt/planners/core.py" in oracle
     shard = {str(p) for p in closure(STAGES["shard"], declared_params("shard"))}
     assert "src/vnrrt/maps/named.py" not in shard and "src/vnrrt/parallel.py" in shard

@@ -12,7 +12,7 @@ from vnrrt.model.metrics import (
     PixelAveragePrecision,
     VertexRecall,
     dilate,
-    heatmap_metrics,
+    heatmap_metric_set,
     metric_collection,
 )
 
@@ -102,7 +102,9 @@ def test_mass_near_averages_over_images():
 
 
 def test_collection_keys_and_perfect_prediction():
-    metrics = metric_collection(radius=0, tau=0.5).clone(prefix="val/")
+    metrics = metric_collection(
+        radius=0, tau=0.5, ap_radius=1.0, endpoint_radius=3.0, taus=(0.5, 0.9, 0.99)
+    ).clone(prefix="val/")
     target = mask((6, 6), (1, 1), (4, 2))
     preds = target.float() * 0.9  # (1, 6, 6)
     ends = mask((6, 6), (1, 1))
@@ -133,7 +135,7 @@ def interior_case():
 
 def test_interior_metrics_leave_the_endpoints_out():
     preds, masks = interior_case()
-    m = heatmap_metrics(radius=0, tau=0.5, taus=(0.5, 0.9), endpoint_radius=0)
+    m = heatmap_metric_set(radius=0, tau=0.5, ap_radius=1.0, endpoint_radius=0, taus=(0.5, 0.9))
     out = {k: float(v(preds, path=masks["vertices"], **masks)) for k, v in m.items()}
     assert out["vertex_recall"] == pytest.approx(3 / 4)  # the endpoints count here ...
     assert out["interior_recall"] == pytest.approx(1 / 2)  # ... not here

@@ -13,12 +13,12 @@ import torch
 from tests.train_helpers import small_cfg
 from vnrrt.config import ConfigError
 from vnrrt.data.heatmaps import HeatmapError, part_file, read_heatmaps, read_parts
-from vnrrt.evaluation.build_instances import build_instances
-from vnrrt.evaluation.instances import Instances
+from vnrrt.data.instances import Instances
+from vnrrt.evaluation.instances import build_instances
 from vnrrt.maps.render import render_instance
 from vnrrt.model.checkpoint import load_network
 from vnrrt.predict import heatmap
-from vnrrt.predict.batch import heatmap_metrics
+from vnrrt.predict.batch import MetricSettings, heatmap_metrics
 from vnrrt.predict.stage import run_predict_metrics, run_predict_part
 from vnrrt.search import path_mask
 
@@ -57,14 +57,20 @@ def test_parts_hold_the_instances_in_order(predicted):
 
 
 def test_metrics_timing_and_figure(predicted):
-    cfg, _, results = predicted
-    for name in ("vertexnet", "nrrtnet"):
+    cfg, _, out = predicted
+    results = out["networks"]
+    for name, target in (("vertexnet", "vertex"), ("nrrtnet", "path")):
         assert results[name]["test_instances"] == N_RANDOM and results[name]["ms_per_map"] > 0
         assert 0 <= results[name]["named/mass_near_vertex"] <= 1
-    saved = json.loads(Path(f"{cfg.paths.metrics}/predict.json").read_text())
-    assert set(saved) == {"vertexnet", "nrrtnet"}
-    assert "test/mass_near_vertex_uniform" in saved["vertexnet"]
-    assert Path(f"{cfg.paths.figures}/heatmaps.png").read_bytes()[:4] == b"\x89PNG"
+        assert results[name]["target"] == target
+    saved = json.loads(Path(cfg.paths.predict_metrics).read_text())
+    assert set(saved["networks"]) == {"vertexnet", "nrrtnet"}
+    assert "test/mass_near_vertex_uniform" in saved["networks"]["vertexnet"]
+    taus = sorted({*cfg.planner.taus, cfg.planner.tau})  # the run's thresholds, no others
+    assert saved["settings"]["taus"] == taus
+    masked = sorted(k for k in saved["networks"]["vertexnet"] if "test/mass_near_interior_tau" in k)
+    assert masked == sorted(f"test/mass_near_interior_tau{t:g}".replace(".", "_") for t in taus)
+    assert Path(cfg.paths.heatmaps_figure).read_bytes()[:4] == b"\x89PNG"
 
 
 def test_a_second_prediction_writes_the_same_bytes(predicted):
@@ -94,7 +100,7 @@ def test_heatmap_metrics_of_a_perfect_map_put_all_mass_near_the_vertices(predict
     inst = Instances(cfg.paths.instances)
     rows = [5, 6]
     perfect = np.stack([path_mask(inst[i].vertices, (64, 64)) for i in rows]).astype(np.float16)
-    m = heatmap_metrics(perfect, inst, rows)
+    m = heatmap_metrics(perfect, inst, rows, MetricSettings(3.0, 0.5, 1.0, 3.0, (0.5,)))
     assert m["mass_near_vertex"] == pytest.approx(1.0)
     assert m["mass_near_vertex_uniform"] < 0.5
 

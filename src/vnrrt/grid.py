@@ -39,6 +39,11 @@ class GridError(ValueError):
     """A grid, cell or point given to vnrrt is malformed; the message names the problem."""
 
 
+class NoPathError(GridError):
+    """Start and goal are not connected (by the 8-connected, no-corner-cutting graph of
+    :mod:`vnrrt.search.astar`, or among the obstacles in continuous space)."""
+
+
 def as_occupancy(grid: np.ndarray, name: str = "grid") -> np.ndarray:
     """Validate ``grid`` and return it as a C-contiguous ``(H, W)`` uint8 array of 0/1.
 

@@ -1,59 +1,56 @@
-"""Display names and the paper's order of planner configurations and map sets (shared by
-the report and the figures)."""
+"""The registry of planners and the display names shared by the reports and the figures:
+planners, map sets and stop rules. Values a name depends on (the stop tolerance, the CI
+level) are arguments, taken from the run's config. A leaf module (no imports), so that any
+stage may use it without depending on the planners' code."""
 
 from __future__ import annotations
 
-PLANNER_ORDER = ("rrt_star", "nrrt_star", "vnrrt_star", "m_vnrrt_star")
-PLANNER_NAMES = {
+PLANNER_NAMES = {  # the planners, in the paper's order, with their display names
     "rrt_star": "RRT*",
     "nrrt_star": "NRRT*",
     "vnrrt_star": "VNRRT*",
     "m_vnrrt_star": "M-VNRRT*",
 }
-MAP_SET_NAMES = {
-    "map_1": "Map 1",
-    "map_2": "Map 2",
-    "map_3": "Map 3",
-    "map_4": "Map 4",
-    "map_5": "Map 5",
-    "random": "Random maps",
-}
-STOP_NAMES = {
-    "initial": "initial solution",
-    "optimal": "within 1% of A*",
-    "optimal_any_angle": "within 1% of the exact optimum",
-}
+PLANNERS = tuple(PLANNER_NAMES)
+MAP_SETS = ("map_1", "map_2", "map_3", "map_4", "map_5", "random")
+MAP_SET_NAMES = dict(zip(MAP_SETS, [f"Map {i}" for i in range(1, 6)] + ["Random maps"]))
+REFERENCE_NAMES = {"optimal": "A*", "optimal_any_angle": "the exact optimum"}
 
 
-INFORMED = "+informed"
+def percent(eps: float) -> str:
+    """A tolerance as a percentage: ``0.01`` -> ``1%``, ``0.005`` -> ``0.5%``."""
+    return f"{100 * eps:g}%"
 
 
-def display_name(key: str) -> str:
-    """``m_vnrrt_star@0.5`` -> ``M-VNRRT* τ=0.5``; a heatmap source suffix ``[src]`` is kept;
-    ``+informed`` -> ``informed ...`` (``rrt_star+informed`` -> ``Informed RRT*``)."""
-    if key.endswith(INFORMED):
-        name = display_name(key.removesuffix(INFORMED))
-        return "Informed RRT*" if name == "RRT*" else f"informed {name}"
-    base, _, source = key.partition("[")
-    planner, _, tau = base.partition("@")
-    name = PLANNER_NAMES.get(planner, planner) + (f" τ={tau}" if tau else "")
-    return name + (f" [{source.rstrip(']')}]" if source else "")
+def stop_name(stop: str, eps: float) -> str:
+    """``initial solution``, ``within 1% of A*`` (eps 0.01), ``within 5% of the exact
+    optimum`` (eps 0.05)."""
+    if stop == "initial":
+        return "initial solution"
+    return f"within {percent(eps)} of {REFERENCE_NAMES[stop]}"
 
 
-def sort_keys(keys) -> list[str]:
-    """Configuration keys in the paper's order (planner, then tau, then source)."""
+def stop_title(stop: str, eps: float) -> str:
+    """The longer form of :func:`stop_name` for section titles."""
+    if stop == "initial":
+        return "initial solution"
+    if stop == "optimal":
+        return f"cost <= {1 + eps:g} x A* length (the paper's optimal solution, eps {eps:g})"
+    return f"cost <= {1 + eps:g} x exact continuous optimum (stricter; ours, eps {eps:g})"
 
-    def rank(key: str):
-        informed = key.endswith(INFORMED)
-        base, _, source = key.removesuffix(INFORMED).partition("[")
-        planner, _, tau = base.partition("@")
-        order = PLANNER_ORDER.index(planner) if planner in PLANNER_ORDER else len(PLANNER_ORDER)
-        return (informed, order, float(tau) if tau else -1.0, source)
 
-    return sorted(keys, key=rank)
+def level_name(level: float) -> str:
+    """A confidence level as text: ``0.95`` -> ``95%``."""
+    return f"{100 * level:g}%"
 
 
 def map_set_title(map_set: str, name: str | None = None) -> str:
     """``Map 3: narrow passage`` (with the named map's name) or ``Random maps``."""
     title = MAP_SET_NAMES.get(map_set, map_set)
     return f"{title}: {name.replace('_', ' ')}" if name else title
+
+
+def mask_taus(taus, tau: float | None) -> list[float]:
+    """The M-VNRRT* thresholds a run evaluates: ``planner.taus`` and ``planner.tau`` (None:
+    ``taus`` alone), sorted, each once."""
+    return sorted({float(t) for t in (*taus, *([] if tau is None else [tau]))})

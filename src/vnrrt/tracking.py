@@ -21,6 +21,7 @@ Browse with ``mlflow ui --backend-store-uri sqlite:///mlflow.db``.
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import sqlite3
 from pathlib import Path
@@ -164,3 +165,42 @@ def mark_stale_runs(uri: str, exp_id: str, tags: dict[str, str]) -> list[str]:
     for run in stale:
         client.set_terminated(run.info.run_id, status="KILLED")
     return [r.info.run_id for r in stale]
+
+
+@dataclasses.dataclass
+class LoggerConfig:
+    """The ``logger`` section (``conf/logger/mlflow.yaml``): whether and where runs go."""
+
+    enabled: bool
+    uri: str | None
+    experiment: str
+    artifact_location: str | None
+    log_model: bool
+    registry_prefix: str | None
+    lightning: dict
+
+    def validate(self) -> None:
+        if not self.experiment:
+            from vnrrt.config import ConfigError
+
+            raise ConfigError("invalid config value logger.experiment: an empty name")
+
+
+def metric_name(*parts: str) -> str:
+    """An MLflow metric name from parts (``@`` is not allowed in names: ``_tau``)."""
+    return "/".join(
+        p.replace("@", "_tau").replace("[", "(").replace("]", ")").replace("+", "_") for p in parts
+    )
+
+
+def flat_metrics(tree: dict, prefix: tuple = ()) -> dict[str, float]:
+    """The finite numbers of a nested dict as ``{metric_name(*path): value}``."""
+    import math
+
+    out = {}
+    for k, v in tree.items():
+        if isinstance(v, dict):
+            out.update(flat_metrics(v, (*prefix, str(k))))
+        elif isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v):
+            out[metric_name(*prefix, str(k))] = float(v)
+    return out

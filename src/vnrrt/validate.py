@@ -15,11 +15,13 @@ from vnrrt.config import ConfigError, check, check_parts, section
 from vnrrt.data.config import LabelsConfig, ScaleConfig
 from vnrrt.data.targets import ENDPOINTS
 from vnrrt.data.targets import TARGETS as NETWORK_TARGETS
-from vnrrt.evaluation.config import EvalConfig, StatsConfig
-from vnrrt.evaluation.protocol import parse_key
-from vnrrt.evaluation.study import OracleConfig, RegimeConfig
+from vnrrt.evaluation.config import EvalConfig, OracleConfig, RegimeConfig, StatsConfig
+from vnrrt.evaluation.keys import ConfigKey
+from vnrrt.evaluation.sources import is_oracle
 from vnrrt.maps.config import DataConfig
+from vnrrt.paths import Paths
 from vnrrt.planners.config import PlannerConfig
+from vnrrt.tracking import LoggerConfig
 
 
 def _taus(planner: PlannerConfig) -> None:
@@ -73,6 +75,8 @@ def validate_config(cfg: DictConfig) -> dict:
         "stats": section(cfg, "stats", StatsConfig),
         "oracle": section(cfg, "oracle", OracleConfig),
         "regime": section(cfg, "regime", RegimeConfig),
+        "paths": section(cfg, "paths", Paths),
+        "logger": section(cfg, "logger", LoggerConfig),
     }
     _taus(typed["planner"])
     networks = _networks(cfg)
@@ -85,8 +89,8 @@ def validate_config(cfg: DictConfig) -> dict:
         )
     _random_maps(typed["eval"], typed["data"], typed["scale"])
     for key in typed["regime"].configurations:
-        spec = parse_key(key, typed["eval"].sources)
-        ok = spec.source is None or spec.source.startswith("oracle_") or spec.source in networks
+        spec = ConfigKey.parse(key, typed["eval"].sources)
+        ok = spec.source is None or is_oracle(spec.source) or spec.source in networks
         check(ok, "regime.configurations", key, f"its source must be a network {sorted(networks)}")
     check_parts(cfg.get("predict", {}).get("parts", [0]), "predict.parts")
     seed = cfg.get("seed")

@@ -31,6 +31,7 @@ from pathlib import Path
 import numpy as np
 
 from vnrrt.io import atomic_write_bytes
+from vnrrt.paths import heatmaps_part_file as part_file
 
 FORMAT_VERSION = 2
 PREFIX = "net_"  # field name prefix of a network's heatmaps
@@ -38,11 +39,6 @@ PREFIX = "net_"  # field name prefix of a network's heatmaps
 
 class HeatmapError(ValueError):
     """A heatmap file is missing or malformed; the message names the file."""
-
-
-def part_file(directory: str | Path, part: int) -> Path:
-    """``<directory>/part_<part>.npz``: the heatmaps of evaluation part ``part``."""
-    return Path(directory) / f"part_{part}.npz"
 
 
 def part_rows(n: int, part: int, parts: int) -> slice:

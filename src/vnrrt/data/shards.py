@@ -36,6 +36,7 @@ from pathlib import Path
 import numpy as np
 
 from vnrrt.io import atomic_write_bytes
+from vnrrt.paths import shard_file  # noqa: F401  (re-exported)
 
 FORMAT_VERSION = 1
 FIELDS = {
@@ -59,11 +60,6 @@ FIELDS = {
 
 class ShardError(ValueError):
     """A shard file is missing, corrupt or of another format; the message names the file."""
-
-
-def shard_file(shards_dir: str | Path, shard_id: int) -> Path:
-    """Path of shard ``shard_id`` in ``shards_dir`` (the name dvc.yaml declares)."""
-    return Path(shards_dir) / f"shard_{shard_id}.npz"
 
 
 def write_shard(path: str | Path, arrays: dict[str, np.ndarray]) -> None:

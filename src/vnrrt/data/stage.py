@@ -10,6 +10,7 @@ from omegaconf import DictConfig
 
 from vnrrt.config import ConfigError, section
 from vnrrt.data.config import LabelsConfig
+from vnrrt.paths import Paths
 
 log = logging.getLogger(__name__)
 
@@ -17,13 +18,12 @@ log = logging.getLogger(__name__)
 def run_shard(cfg: DictConfig, shard_id: int) -> dict:
     """Stage ``shard@<id>``: generate and label one shard into ``paths.shards``."""
     from vnrrt.data.build import build_shard
-    from vnrrt.data.shards import shard_file
     from vnrrt.maps.config import DataConfig
 
     if shard_id not in cfg.scale.shards:
         raise ConfigError(f"shard {shard_id} is not in scale.shards {list(cfg.scale.shards)}")
     return build_shard(
-        shard_file(cfg.paths.shards, shard_id),
+        section(cfg, "paths", Paths).shard(shard_id),
         shard_id,
         seed=int(cfg.seed),
         maps_per_shard=int(cfg.scale.maps_per_shard),
@@ -36,11 +36,12 @@ def run_shard(cfg: DictConfig, shard_id: int) -> dict:
 def run_named_maps(cfg: DictConfig) -> dict:
     """Stage ``named_maps``: the five named maps as a shard, and their figure (Fig. 4)."""
     from vnrrt.data.build_named import build_named_maps
+    from vnrrt.data.reader import Shard
     from vnrrt.viz.maps import save_named_maps
 
-    labels = section(cfg, "labels", LabelsConfig)
-    counts = build_named_maps(cfg.paths.named_maps, int(cfg.data.size), labels)
-    save_named_maps(cfg.paths.named_maps, f"{cfg.paths.figures}/named_maps.png")
+    paths, labels = section(cfg, "paths", Paths), section(cfg, "labels", LabelsConfig)
+    counts = build_named_maps(paths.named_maps, int(cfg.data.size), labels)
+    save_named_maps(Shard(paths.named_maps), paths.named_maps_figure)
     return counts
 
 
@@ -49,7 +50,8 @@ def run_manifest(cfg: DictConfig) -> dict:
     from vnrrt.data.manifest import build_manifest
     from vnrrt.io import write_json
 
+    paths = section(cfg, "paths", Paths)
     shards = [int(s) for s in cfg.scale.shards]
-    summary = build_manifest(cfg.paths.shards, shards, cfg.paths.manifest)
-    write_json(f"{cfg.paths.metrics}/data.json", summary)
+    summary = build_manifest(paths.shards, shards, paths.manifest)
+    write_json(paths.data_metrics, summary)
     return summary

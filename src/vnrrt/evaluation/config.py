@@ -1,22 +1,49 @@
-"""The ``eval`` config section: the typed mirror of ``conf/eval/default.yaml``."""
+"""The evaluation's config sections, typed mirrors of ``conf/eval``, ``conf/stats``,
+``conf/oracle`` and ``conf/regime``: one module, one dataclass per section.
+
+The pipeline builds them only through :func:`vnrrt.config.section` from the composed config,
+which must give every key: the dataclass defaults (the paper's values where it has them)
+serve library callers and never stand in for a config key inside the pipeline.
+"""
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from vnrrt.config import ConfigError, check_parts
+from vnrrt.config import ConfigError, check, check_parts
+from vnrrt.evaluation.keys import ConfigKey
+from vnrrt.evaluation.sources import ORACLE_KINDS
+from vnrrt.names import PLANNERS, mask_taus
 
-PLANNERS = ("rrt_star", "nrrt_star", "vnrrt_star", "m_vnrrt_star")
 DEFAULT_SOURCES = {"nrrt_star": "nrrtnet", "vnrrt_star": "vertexnet", "m_vnrrt_star": "vertexnet"}
+REGIME_RADIUS_MODES = ("shrinking", "fixed1", "fixed2")  # fixedK: a fixed near radius K x eta
 
 
 @dataclass
-class EvalConfig:
-    """The ``eval`` config section (paper, Experiments). Trial counts are per instance."""
+class Configurations:
+    """``eval.planners``, ``eval.sources`` and ``eval.informed``: which configurations run
+    (:func:`vnrrt.evaluation.protocol.configurations`), for the stages that read only these."""
 
     planners: list[str] = field(default_factory=lambda: list(PLANNERS))
     # planner -> heatmap source it samples (a network name of `networks`, or an oracle)
     sources: dict[str, str] = field(default_factory=lambda: dict(DEFAULT_SOURCES))
+    informed: bool = True  # also every configuration with informed sampling (random maps)
+
+    def validate(self) -> None:
+        """Raise :class:`ConfigError` naming the first invalid value."""
+        unknown = sorted(set(self.planners) - set(PLANNERS))
+        if unknown or not self.planners:
+            raise ConfigError(f"invalid eval.planners {self.planners}: known {PLANNERS}")
+        for p in self.planners:
+            if p != "rrt_star" and p not in self.sources:
+                raise ConfigError(f"eval.sources has no heatmap source for planner {p!r}")
+        check(isinstance(self.informed, bool), "eval.informed", self.informed, "true or false")
+
+
+@dataclass
+class EvalConfig(Configurations):
+    """The ``eval`` section (paper, Experiments). Trial counts are per instance."""
+
     named_initial: int = 1000  # paper: 1,000 trials per named map
     named_optimal: int = 100  # paper: 100
     random_maps: int = 1000  # paper: 1,000 random test maps (R instances), one trial each
@@ -24,10 +51,10 @@ class EvalConfig:
     random_optimal: int = 1
     any_angle: bool = True  # also the optimal_any_angle stop rule (exact optimum)
     parts: list[int] = field(default_factory=lambda: [0])  # trial parts: [0, 1, ..., K-1]
-    informed: bool = True  # also every configuration with informed sampling (random maps)
 
     def validate(self) -> None:
         """Raise :class:`ConfigError` naming the first invalid value."""
+        super().validate()
         check_parts(self.parts, "eval.parts")
         for name in (
             "named_initial",
@@ -39,17 +66,31 @@ class EvalConfig:
             value = getattr(self, name)
             if not isinstance(value, int) or value < 0:
                 raise ConfigError(f"invalid config value eval.{name}={value!r}: must be >= 0")
-        unknown = sorted(set(self.planners) - set(PLANNERS))
-        if unknown or not self.planners:
-            raise ConfigError(f"invalid eval.planners {self.planners}: known {PLANNERS}")
-        for p in self.planners:
-            if p != "rrt_star" and p not in self.sources:
-                raise ConfigError(f"eval.sources has no heatmap source for planner {p!r}")
+
+
+@dataclass
+class Rules:
+    """``planner.eps``, ``planner.taus`` and ``planner.tau``: the stop tolerance and the
+    M-VNRRT* thresholds, for the stages that name them without planning."""
+
+    eps: float = 0.01
+    taus: list[float] = field(default_factory=lambda: [0.5, 0.9, 0.99])
+    tau: float = 0.5
+
+    def validate(self) -> None:
+        check(self.eps >= 0, "planner.eps", self.eps, "must be >= 0")
+        ok = all(0 < t <= 1 for t in [*self.taus, self.tau])
+        check(ok, "planner.taus", [*self.taus, self.tau], "every tau must be in (0, 1]")
+
+    @property
+    def mask_taus(self) -> list[float]:
+        """Every M-VNRRT* threshold of a run (:func:`mask_taus`)."""
+        return mask_taus(self.taus, self.tau)
 
 
 @dataclass
 class StatsConfig:
-    """The ``stats`` section: bootstrap confidence intervals of the report."""
+    """The ``stats`` section: bootstrap confidence intervals of the reports."""
 
     bootstrap: int = 2000  # resamples of every confidence interval
     level: float = 0.95  # confidence level of intervals and verdicts
@@ -59,3 +100,57 @@ class StatsConfig:
             raise ConfigError(f"invalid config value stats.bootstrap={self.bootstrap!r}: >= 100")
         if not 0.5 < self.level < 1:
             raise ConfigError(f"invalid config value stats.level={self.level!r}: in (0.5, 1)")
+
+
+@dataclass
+class OracleConfig:
+    """The ``oracle`` section: the oracle study (:mod:`vnrrt.evaluation.sampling_ideas`)."""
+
+    kinds: list[str] = field(default_factory=lambda: list(ORACLE_KINDS))
+    sigma: float = 1.0
+    floor: float = 0.0
+    radius: float = 3.0
+    qualities: list[float] = field(default_factory=lambda: [1.0, 0.5, 0.2, 0.1, 0.05, 0.02, 0.0])
+    random_maps: int = 1000
+    trials: int = 1
+    parts: list[int] = field(default_factory=lambda: [0])
+
+    def validate(self) -> None:
+        unknown = sorted(set(self.kinds) - set(ORACLE_KINDS))
+        check(not unknown, "oracle.kinds", self.kinds, f"known: {ORACLE_KINDS}")
+        check(self.sigma >= 0, "oracle.sigma", self.sigma, "must be >= 0 px")
+        check(0 <= self.floor <= 1, "oracle.floor", self.floor, "must be in [0, 1]")
+        check(self.radius >= 0, "oracle.radius", self.radius, "must be >= 0 px")
+        ok = bool(self.qualities) and all(0 <= q <= 1 for q in self.qualities)
+        check(ok, "oracle.qualities", self.qualities, "every q must be in [0, 1]")
+        check(self.random_maps >= 1, "oracle.random_maps", self.random_maps, "must be >= 1")
+        check(self.trials >= 1, "oracle.trials", self.trials, "must be >= 1")
+        check_parts(self.parts, "oracle.parts")
+
+
+@dataclass
+class RegimeConfig:
+    """The ``regime`` section: the planner-regime sweep."""
+
+    etas: list[float] = field(default_factory=lambda: [3.0, 5.0, 10.0, 20.0, 40.0])
+    radius_modes: list[str] = field(default_factory=lambda: list(REGIME_RADIUS_MODES))
+    goal_radii: list = field(default_factory=lambda: [None, 2.0])
+    configurations: list[str] = field(default_factory=lambda: ["rrt_star"])
+    random_maps: int = 1000
+    parts: list[int] = field(default_factory=lambda: [0])
+
+    def validate(self) -> None:
+        ok = bool(self.etas) and all(e > 0 for e in self.etas)
+        check(ok, "regime.etas", self.etas, "every step must be > 0 px")
+        bad = sorted(set(self.radius_modes) - set(REGIME_RADIUS_MODES))
+        ok = not bad and bool(self.radius_modes)
+        check(ok, "regime.radius_modes", bad, f"known {REGIME_RADIUS_MODES}")
+        ok = all(g is None or g > 0 for g in self.goal_radii) and bool(self.goal_radii)
+        check(ok, "regime.goal_radii", self.goal_radii, "null or > 0 px")
+        for key in self.configurations:
+            try:
+                ConfigKey.parse(key)
+            except ConfigError as err:
+                raise ConfigError(f"invalid regime.configurations entry {key!r}: {err}") from None
+        check(self.random_maps >= 1, "regime.random_maps", self.random_maps, "must be >= 1")
+        check_parts(self.parts, "regime.parts")

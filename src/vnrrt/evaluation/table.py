@@ -17,6 +17,7 @@ import numpy as np
 import pandas as pd
 
 from vnrrt.io import write_text
+from vnrrt.paths import table_part_file as part_file
 
 # Cost bounds (x reference length) whose first-reach time is recorded in optimal runs: the
 # convergence curve (cost versus time) of every trial.
@@ -105,11 +106,6 @@ def conform(table: pd.DataFrame, where: str) -> pd.DataFrame:
         else:
             out[col] = out[col].astype(dtype)
     return out
-
-
-def part_file(directory: str | Path, part: int) -> Path:
-    """``<directory>/part_<part>.csv``: the trial table of part ``part``."""
-    return Path(directory) / f"part_{part}.csv"
 
 
 def write_table(table: pd.DataFrame, path: str | Path) -> None:

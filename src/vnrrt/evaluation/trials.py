@@ -16,14 +16,14 @@ import dataclasses
 import functools
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
-import numpy as np
 import pandas as pd
 
-from vnrrt.evaluation import oracle
-from vnrrt.evaluation.instances import EvalInstance
-from vnrrt.evaluation.protocol import PlannerSpec, TrialJob, trial_jobs, trial_seed
+from vnrrt.data.instances import EvalInstance
+from vnrrt.evaluation import sources
+from vnrrt.evaluation.keys import ConfigKey
+from vnrrt.evaluation.protocol import TrialJob, trial_jobs, trial_seed
 from vnrrt.evaluation.table import CONVERGENCE_FACTORS, TrialRow, frame
 from vnrrt.parallel import parallel_map
 from vnrrt.planners import PlannerConfig, make_sampler, plan, warmup
@@ -31,45 +31,29 @@ from vnrrt.planners import PlannerConfig, make_sampler, plan, warmup
 
 @dataclass(frozen=True)
 class HeatSettings:
-    """How oracle heatmaps are built and heatmaps measured: blur ``sigma`` and ``floor`` of
-    the oracles, ``radius`` (px) of "mass near the target", and the target of each trained
-    network (``'path'`` or ``'interior_vertices'``)."""
+    """How heatmaps are measured and oracle heatmaps built: ``radius`` (px) of "mass near the
+    target" (``oracle.radius``), the target of each trained network (``'path'`` or
+    ``'interior_vertices'``), and the oracles' blur ``sigma`` (px) and uniform ``floor``
+    (``oracle.sigma``, ``oracle.floor``; None where a stage samples no oracle)."""
 
-    sigma: float = 1.0
-    floor: float = 0.0
-    radius: float = 3.0
-    targets: dict[str, str] = field(default_factory=dict)
-
-
-def source_heatmap(source: str, inst: EvalInstance, heat: HeatSettings) -> np.ndarray:
-    """The heatmap a job samples: a network's (on the instance) or an oracle's (built)."""
-    if source in inst.heatmaps:
-        return inst.heatmaps[source]
-    if source.startswith("oracle_"):
-        return oracle.instance_heatmap(source, inst, heat.sigma, heat.floor)
-    known = sorted(inst.heatmaps)
-    raise KeyError(f"instance {inst.map} has no {source!r} heatmap (known: {known})")
-
-
-def source_target(source: str, heat: HeatSettings) -> str:
-    """The target a source's heatmap aims at (for ``heat_mass``)."""
-    if source.startswith("oracle_"):
-        return oracle.TARGET[oracle.parse_source(source)[0]]
-    return heat.targets.get(source, "path")
+    radius: float
+    targets: dict[str, str]
+    sigma: float | None = None
+    floor: float | None = None
 
 
 def _row(job, inst, trial, seed, result, setup, ref, mass) -> TrialRow:
-    spec = job.spec
+    key = job.key
     return TrialRow(
         seq=job.seq + trial - job.first,
         instance=job.instance,
         map_set=inst.map_set,
         map=inst.map,
         cluster=inst.cluster,
-        key=spec.key,
-        planner=spec.planner,
-        tau=math.nan if spec.tau is None else float(spec.tau),
-        source=spec.source or "",
+        key=key.text,
+        planner=key.planner,
+        tau=math.nan if key.tau is None else float(key.tau),
+        source=key.source or "",
         stop=job.stop,
         trial=trial,
         seed=seed,
@@ -99,17 +83,17 @@ def run_job(
     """The rows of one job on its instance (``args``: the job and its instance);
     ``configs`` holds the planner settings of each regime cell (``''``: the protocol's)."""
     job, inst = args
-    spec, stop, config = job.spec, job.stop, configs[job.regime]
-    if spec.informed:
+    key, stop, config = job.key, job.stop, configs[job.regime]
+    if key.informed:
         config = config.replace(informed=True)
     warmup()
     heatmap, mass = None, math.nan
-    if spec.source is not None:
-        heatmap = source_heatmap(spec.source, inst, heat)
-        mask = oracle.target_mask(inst, source_target(spec.source, heat))
-        mass = oracle.mass_near(heatmap, mask, heat.radius)
+    if key.source is not None:
+        heatmap = sources.source_heatmap(key.source, inst, heat.sigma, heat.floor)
+        mask = sources.target_mask(inst, sources.source_target(key.source, heat.targets))
+        mass = sources.mass_near(heatmap, mask, heat.radius)
     tick = time.perf_counter()
-    sampler = make_sampler(spec.planner, inst.grid.shape, heatmap, spec.tau, config.mix)
+    sampler = make_sampler(key.planner, inst.grid.shape, heatmap, key.tau, config.mix)
     setup = time.perf_counter() - tick
     ref = inst.reference(stop)
     milestones = tuple(f * ref for f in CONVERGENCE_FACTORS) if stop != "initial" else ()
@@ -120,7 +104,7 @@ def run_job(
             inst.grid,
             inst.start,
             inst.goal,
-            spec.planner,
+            key.planner,
             sampler=sampler,
             stop="initial" if stop == "initial" else "optimal",
             reference_length=ref,
@@ -134,8 +118,8 @@ def run_job(
 
 def _needed(job: TrialJob, inst: EvalInstance) -> tuple[TrialJob, EvalInstance]:
     """The job with an instance holding only the heatmap it samples (less to pickle)."""
-    src = job.spec.source
-    if src is not None and not src.startswith("oracle_") and src not in inst.heatmaps:
+    src = job.key.source
+    if src is not None and not sources.is_oracle(src) and src not in inst.heatmaps:
         known = sorted(inst.heatmaps)
         raise KeyError(f"instance {inst.map} has no {src!r} heatmap (known: {known})")
     keep = {src: inst.heatmaps[src]} if src in inst.heatmaps else {}
@@ -145,16 +129,16 @@ def _needed(job: TrialJob, inst: EvalInstance) -> tuple[TrialJob, EvalInstance]:
 def run_jobs(
     jobs: list[TrialJob],
     instances: dict[int, EvalInstance],
-    seed: int = 0,
-    workers: int = 0,
-    config: PlannerConfig | dict[str, PlannerConfig] | None = None,
-    heat: HeatSettings | None = None,
+    seed: int,
+    workers: int,
+    config: PlannerConfig | dict[str, PlannerConfig],
+    heat: HeatSettings,
 ) -> pd.DataFrame:
     """The rows of ``jobs`` (on ``instances[job.instance]``) as a trial table in ``seq``
-    order. ``config``: the planner settings, or one per regime cell. A trial that exhausts
-    a budget is a row with ``success=False``."""
-    configs = config if isinstance(config, dict) else {"": config or PlannerConfig()}
-    fn = functools.partial(run_job, seed=seed, configs=configs, heat=heat or HeatSettings())
+    order. ``config``: the planner settings, or one per regime cell (label -> settings). A
+    trial that exhausts a budget is a row with ``success=False``."""
+    configs = config if isinstance(config, dict) else {"": config}
+    fn = functools.partial(run_job, seed=seed, configs=configs, heat=heat)
     items = [_needed(job, instances[job.instance]) for job in jobs]
     rows = parallel_map(fn, items, workers, "trials")
     return frame([r for rs in rows for r in rs])
@@ -162,15 +146,20 @@ def run_jobs(
 
 def run_trials(
     instances: list[EvalInstance],
-    specs: list[PlannerSpec],
+    keys: list[ConfigKey],
     counts: dict[tuple[str, str], int],
     seed: int = 0,
     workers: int = 0,
     config: PlannerConfig | None = None,
     heat: HeatSettings | None = None,
 ) -> pd.DataFrame:
-    """All trials of ``specs`` on ``instances`` (protocol order) as a table;
-    ``counts[(kind, stop)]`` trials per instance, kind ``'named'`` or ``'random'``."""
-    jobs = trial_jobs([inst.kind for inst in instances], specs, counts)
+    """All trials of ``keys`` on ``instances`` (protocol order) as a table, for library
+    callers; ``counts[(kind, stop)]`` trials per instance, kind ``'named'`` or ``'random'``;
+    ``config``/``heat`` default to the library's :class:`PlannerConfig` and
+    :data:`LIBRARY_HEAT` (the pipeline passes its config's, :func:`run_jobs`)."""
+    jobs = trial_jobs([inst.kind for inst in instances], keys, counts)
     by_index = dict(enumerate(instances))
-    return run_jobs(jobs, by_index, seed, workers, config, heat)
+    return run_jobs(jobs, by_index, seed, workers, config or PlannerConfig(), heat or LIBRARY_HEAT)
+
+
+LIBRARY_HEAT = HeatSettings(radius=3.0, targets={}, sigma=1.0, floor=0.0)  # conf/oracle's

@@ -161,16 +161,16 @@ def tau_key(name: str, tau: float) -> str:
     return f"{name}_tau{tau:g}".replace(".", "_")
 
 
-def heatmap_metrics(radius: float = 3.0, tau: float = 0.5, taus=(0.5, 0.9, 0.99),
-                    endpoint_radius: float = 3.0) -> dict[str, Metric]:  # fmt: skip
+def heatmap_metric_set(radius: float, tau: float, ap_radius: float, endpoint_radius: float,
+                       taus=()) -> dict[str, Metric]:  # fmt: skip
     """The heatmap metrics, updated with ``update(preds=, vertices=, path=, interior=,
     endpoints=)`` (``(B, H, W)`` bool masks; ``interior``: vertices without start and goal):
 
     * ``vertex_recall`` / ``interior_recall``: vertices (all, interior) with a pixel of
       probability >= ``tau`` within ``radius`` px;
-    * ``interior_ap``: pixel AP against the interior vertices (dilated by 1 px), the start
-      and goal disks (``endpoint_radius``) ignored; ``path_ap``: against the path (dilated
-      by 1 px), the same rule for the path network;
+    * ``interior_ap``: pixel AP against the interior vertices (dilated by ``ap_radius`` px),
+      the start and goal disks (``endpoint_radius``) ignored; ``path_ap``: against the path
+      (dilated by ``ap_radius`` px), the same rule for the path network;
     * ``mass_near_<mask>`` and ``..._uniform``: the share of the heatmap's mass within
       ``radius`` px of the path, all vertices, the interior vertices, and a uniform map's;
     * ``mass_on_endpoints``: the share within ``endpoint_radius`` of start and goal;
@@ -181,8 +181,8 @@ def heatmap_metrics(radius: float = 3.0, tau: float = 0.5, taus=(0.5, 0.9, 0.99)
     metrics = {
         "vertex_recall": VertexRecall(radius, tau),
         "interior_recall": VertexRecall(radius, tau, mask="interior"),
-        "interior_ap": MaskedAveragePrecision("interior", 1.0, "endpoints", endpoint_radius),
-        "path_ap": MaskedAveragePrecision("path", 1.0),
+        "interior_ap": MaskedAveragePrecision("interior", ap_radius, "endpoints", endpoint_radius),
+        "path_ap": MaskedAveragePrecision("path", ap_radius),
         "mass_near_path": MassNear(radius, "path"),
         "mass_near_path_uniform": MassNear(radius, "path", uniform=True),
         "mass_near_vertex": MassNear(radius, "vertices"),
@@ -197,13 +197,14 @@ def heatmap_metrics(radius: float = 3.0, tau: float = 0.5, taus=(0.5, 0.9, 0.99)
     return metrics
 
 
-def metric_collection(radius: float = 3.0, tau: float = 0.5, ap_thresholds: int = 101,
+def metric_collection(radius: float, tau: float, ap_radius: float, endpoint_radius: float,
+                      taus=(), ap_thresholds: int = 101,
                       with_target: bool = True) -> MetricCollection:  # fmt: skip
     """The metrics of one split, updated with ``update(preds=, target=, vertices=, path=,
     interior=, endpoints=)``: pixel ``ap`` (binned over ``ap_thresholds``) and ``f1`` (at 0.5)
     against the training target (unless ``with_target`` is False), and
-    :func:`heatmap_metrics`."""
-    metrics = heatmap_metrics(radius, tau)
+    :func:`heatmap_metric_set` (its arguments)."""
+    metrics = heatmap_metric_set(radius, tau, ap_radius, endpoint_radius, taus)
     if with_target:
         metrics["ap"] = PixelAveragePrecision(ap_thresholds)
         metrics["f1"] = BinaryF1Score(threshold=0.5, validate_args=False)

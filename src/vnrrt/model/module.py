@@ -30,8 +30,9 @@ class VertexNetModule(L.LightningModule):
     scheduler: optional factory ``optimizer -> LRScheduler``; ``total_steps`` is filled in
         from the trainer when the scheduler takes it and the factory leaves it unset.
     scheduler_interval: ``"step"`` or ``"epoch"``.
-    metric_radius, metric_tau: "within r pixels" and the probability threshold of the
-        metrics.
+    metric_radius, metric_tau, metric_ap_radius, metric_endpoint_radius: "within r pixels",
+        the probability threshold, the AP targets' dilation and the start/goal disks of the
+        metrics (:func:`vnrrt.model.metrics.heatmap_metric_set`).
     train_metrics_every: update the training metrics on every n-th batch only (they cost
         about a quarter of a CPU step; loss is logged on every batch).
     channels_last: use the channels-last memory format (faster on CUDA with bf16, and on
@@ -42,7 +43,8 @@ class VertexNetModule(L.LightningModule):
 
     def __init__(self, net: nn.Module, loss: nn.Module, optimizer: Callable, scheduler=None,
                  scheduler_interval: str = "step", metric_radius: float = 3.0,
-                 metric_tau: float = 0.5, channels_last: bool = True,
+                 metric_tau: float = 0.5, metric_ap_radius: float = 1.0,
+                 metric_endpoint_radius: float = 3.0, channels_last: bool = True,
                  train_metrics_every: int = 1,
                  record: dict[str, Any] | None = None) -> None:  # fmt: skip
         super().__init__()
@@ -54,7 +56,9 @@ class VertexNetModule(L.LightningModule):
         self.optimizer_factory, self.scheduler_factory = optimizer, scheduler
         self.scheduler_interval = scheduler_interval
         for split in SPLITS:  # train_metrics, val_metrics, test_metrics
-            metrics = metric_collection(metric_radius, metric_tau).clone(prefix=f"{split}/")
+            metrics = metric_collection(
+                metric_radius, metric_tau, metric_ap_radius, metric_endpoint_radius
+            ).clone(prefix=f"{split}/")
             setattr(self, f"{split}_metrics", metrics)
         self.channels_last, self.train_metrics_every = channels_last, train_metrics_every
         self.record = dict(record or {})

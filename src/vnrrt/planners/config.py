@@ -11,7 +11,8 @@ import dataclasses
 import math
 from dataclasses import dataclass, field
 
-PLANNERS = ("rrt_star", "nrrt_star", "vnrrt_star", "m_vnrrt_star")
+from vnrrt.names import PLANNERS  # noqa: F401  (re-exported: the one list of planners)
+
 REFERENCES = ("astar", "any_angle", "taut")
 RADIUS_MODES = ("shrinking", "fixed")
 

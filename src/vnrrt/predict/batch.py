@@ -1,6 +1,6 @@
 """Batch prediction of the evaluation instances and the heatmap metrics.
 
-Inputs are rendered from the instances file (:mod:`vnrrt.evaluation.instances`) exactly as
+Inputs are rendered from the instances file (:mod:`vnrrt.data.instances`) exactly as
 in training (the checkpoint's record), so prediction needs neither the shards nor a data
 loader. Heatmaps are stored as float16 (:mod:`vnrrt.data.heatmaps`).
 """
@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import contextlib
 import time
+from dataclasses import dataclass
 
 import numpy as np
 import torch
@@ -20,7 +21,7 @@ from vnrrt.model.metrics import metric_collection
 
 def inputs(instances, rows, render: dict) -> np.ndarray:
     """Network inputs ``(N, 3, S, S)`` float32 of instances ``rows`` of an
-    :class:`~vnrrt.evaluation.instances.Instances` file."""
+    :class:`~vnrrt.data.instances.Instances` file."""
     out = []
     for i in rows:
         inst = instances[int(i)]
@@ -51,13 +52,27 @@ def predict(
     return maps, seconds / max(len(images), 1)
 
 
-def heatmap_metrics(
-    maps: np.ndarray, instances, rows, radius: float = 3.0, tau: float = 0.5
-) -> dict[str, float]:
-    """Heatmap metrics (:func:`vnrrt.model.metrics.heatmap_metrics`, within ``radius`` px,
-    recall at ``tau``) of ``maps`` ``(N, S, S)`` against the A* paths and vertices of
-    instances ``rows``."""
-    metrics = metric_collection(radius, tau, with_target=False)
+@dataclass(frozen=True)
+class MetricSettings:
+    """How heatmaps are measured (``predict.metric_*``, ``planner.taus``/``planner.tau``):
+    "near" within ``radius`` px, recall at probability ``tau``, AP against targets dilated by
+    ``ap_radius`` px with start/goal disks of ``endpoint_radius`` px left out, and the
+    interior mass after M-VNRRT*'s mask at each of ``taus``."""
+
+    radius: float
+    tau: float
+    ap_radius: float
+    endpoint_radius: float
+    taus: tuple[float, ...] = ()
+
+
+def heatmap_metrics(maps: np.ndarray, instances, rows, ms: MetricSettings) -> dict[str, float]:
+    """Heatmap metrics (:func:`vnrrt.model.metrics.heatmap_metric_set` with the settings
+    ``ms``) of ``maps`` ``(N, S, S)`` against the A* paths and vertices of instances
+    ``rows``."""
+    metrics = metric_collection(
+        ms.radius, ms.tau, ms.ap_radius, ms.endpoint_radius, ms.taus, with_target=False
+    )
     shape = (instances.size, instances.size)
     for k, i in enumerate(rows):
         inst = instances[int(i)]

@@ -1,22 +1,23 @@
 """Entry points of the prediction stages.
 
 * ``predict@<k>``: heatmaps of every network of ``predict.networks`` for part ``k`` of the
-  instances file -> ``<paths.heatmaps>/part_<k>.npz`` (bytes depend only on the inputs and
-  ``predict.threads``; the inference time goes to ``<paths.timing>/predict_<k>.json``);
-* ``predict_metrics``: the heatmap metrics over the named maps and the random instances,
-  the inference time per map (``<paths.metrics>/predict.json``) and Fig. 3.
+  instances file -> ``paths.heatmaps_part(k)`` (bytes depend only on the inputs and
+  ``predict.threads``; the inference time goes to ``paths.timing_part(k)``);
+* ``predict_metrics``: the heatmap metrics over the named maps and the random instances with
+  their settings, the inference time per map (``paths.predict_metrics``) and Fig. 3
+  (``paths.heatmaps_figure``).
 """
 
 from __future__ import annotations
 
 import logging
-from pathlib import Path
 
 import numpy as np
 import torch
 from omegaconf import DictConfig
 
-from vnrrt.config import ConfigError, check_parts
+from vnrrt.config import ConfigError, check_parts, section
+from vnrrt.paths import Paths
 
 log = logging.getLogger(__name__)
 
@@ -28,14 +29,14 @@ def pick_device(device: str) -> torch.device:
     return torch.device(device)
 
 
-def _networks(cfg: DictConfig) -> dict:
-    """``{name: (network, record, checkpoint sha256)}`` of every ``predict.networks``."""
+def _networks(names: list[str], paths: Paths) -> dict:
+    """``{name: (network, record, checkpoint sha256)}`` of each network of ``names``."""
     from vnrrt.io import sha256
     from vnrrt.model.checkpoint import load_network
 
     out = {}
-    for name in cfg.predict.networks:
-        ckpt = Path(cfg.paths.models) / f"{name}.ckpt"
+    for name in names:
+        ckpt = paths.checkpoint(name)
         net, record = load_network(ckpt, name, verify=True)
         out[name] = (net, record, sha256(ckpt))
     return out
@@ -43,78 +44,101 @@ def _networks(cfg: DictConfig) -> dict:
 
 def run_predict_part(cfg: DictConfig, part: int) -> dict:
     """Stage ``predict@<part>`` (module doc); returns ``{network: ms per map}``."""
-    from vnrrt.data.heatmaps import part_file, part_rows, write_heatmaps
-    from vnrrt.evaluation.instances import Instances
+    from vnrrt.data.heatmaps import part_rows, write_heatmaps
+    from vnrrt.data.instances import Instances
     from vnrrt.io import write_json
     from vnrrt.predict.batch import inputs, predict
 
+    paths = section(cfg, "paths", Paths)
     parts = check_parts(cfg.predict.parts, "predict.parts")
     if part not in parts:
         raise ConfigError(f"part {part} is not in predict.parts {parts}")
     torch.set_num_threads(int(cfg.predict.threads))
-    instances = Instances(cfg.paths.instances)
+    instances = Instances(paths.instances)
     rows = np.arange(len(instances))[part_rows(len(instances), part, len(parts))]
-    device, maps, meta, timing = pick_device(cfg.predict.device), {}, {}, {}
-    for name, (net, record, sha) in _networks(cfg).items():
+    device, maps, meta, timing = pick_device(str(cfg.predict.device)), {}, {}, {}
+    for name, (net, record, sha) in _networks(list(cfg.predict.networks), paths).items():
         images = inputs(instances, rows, record["render"])
         maps[name], sec = predict(net, images, int(cfg.predict.batch_size), device)
         meta[name] = {"target": record["target"], "checkpoint_sha256": sha}
         timing[name] = {"ms_per_map": 1e3 * sec, "device": device.type, "maps": len(rows)}
     write_heatmaps(
-        part_file(cfg.paths.heatmaps, part),
+        paths.heatmaps_part(part),
         instances.keys[rows],
         maps,
         networks=meta,
         part=part,
         parts=len(parts),
     )
-    write_json(Path(cfg.paths.timing) / f"predict_{part}.json", timing)
+    write_json(paths.timing_part(part), timing)
     log.info("part %d/%d: %d instances x %d networks", part, len(parts), len(rows), len(maps))
     return {n: t["ms_per_map"] for n, t in timing.items()}
 
 
+def metric_settings(cfg: DictConfig):
+    """The heatmap metrics' settings: ``predict.metric_*`` and the M-VNRRT* thresholds."""
+    from vnrrt.names import mask_taus
+    from vnrrt.predict.batch import MetricSettings
+
+    p = cfg.predict
+    return MetricSettings(
+        float(p.metric_radius),
+        float(p.metric_tau),
+        float(p.metric_ap_radius),
+        float(p.metric_endpoint_radius),
+        tuple(mask_taus(list(cfg.planner.taus), float(cfg.planner.tau))),
+    )
+
+
 def run_predict_metrics(cfg: DictConfig) -> dict:
-    """Stage ``predict_metrics`` (module doc); returns the metrics written."""
+    """Stage ``predict_metrics`` (module doc); returns what it wrote: ``{"settings": the
+    metrics' settings, "networks": {network: metrics, target, inference time}}``."""
+    import dataclasses
+
     from vnrrt.data.heatmaps import read_parts
-    from vnrrt.evaluation.instances import Instances
+    from vnrrt.data.instances import Instances
     from vnrrt.io import read_json, write_json
     from vnrrt.predict.batch import heatmap_metrics
     from vnrrt.viz.evaluation import save_heatmaps
 
+    paths = section(cfg, "paths", Paths)
     parts = check_parts(cfg.predict.parts, "predict.parts")
-    instances = Instances(cfg.paths.instances)
-    files = read_parts(cfg.paths.heatmaps, parts)
+    instances = Instances(paths.instances)
+    files = read_parts(paths.heatmaps, parts)
     if not np.array_equal(files["keys"], instances.keys):
         raise ConfigError(
-            f"heatmap parts in {cfg.paths.heatmaps} do not cover the instances of "
-            f"{cfg.paths.instances} (re-run `dvc repro`)"
+            f"heatmap parts in {paths.heatmaps} do not cover the instances of "
+            f"{paths.instances} (re-run `dvc repro`)"
         )
     kinds = np.array(instances.kinds)
     named, random = np.flatnonzero(kinds == "named"), np.flatnonzero(kinds == "random")
-    timing = [read_json(Path(cfg.paths.timing) / f"predict_{k}.json") for k in parts]
-    radius = float(cfg.predict.metric_radius)
+    timing = [read_json(paths.timing_part(k)) for k in parts]
+    ms = metric_settings(cfg)
     results = {}
     for name, maps in files["maps"].items():
         counts = [t[name]["maps"] for t in timing]
-        ms = float(np.average([t[name]["ms_per_map"] for t in timing], weights=counts))
         results[name] = {
             **{
                 f"test/{k}": v
-                for k, v in heatmap_metrics(maps[random], instances, random, radius).items()
+                for k, v in heatmap_metrics(maps[random], instances, random, ms).items()
             },
             **{
                 f"named/{k}": v
-                for k, v in heatmap_metrics(maps[named], instances, named, radius).items()
+                for k, v in heatmap_metrics(maps[named], instances, named, ms).items()
             },
             "test_instances": len(random),
-            "ms_per_map": ms,
+            "target": files["meta"][0]["networks"][name]["target"]["kind"],
+            "ms_per_map": float(
+                np.average([t[name]["ms_per_map"] for t in timing], weights=counts)
+            ),
             "device": timing[0][name]["device"],
         }
         log.info("%s: %s", name, results[name])
-    write_json(Path(cfg.paths.metrics) / "predict.json", results)
+    out = {"settings": dataclasses.asdict(ms), "networks": results}
+    write_json(paths.predict_metrics, out)
     shown = [instances[int(i)] for i in named]
     save_heatmaps(
-        Path(cfg.paths.figures) / "heatmaps.png",
+        paths.heatmaps_figure,
         [i.grid for i in shown],
         [i.path for i in shown],
         [i.vertices for i in shown],
@@ -123,4 +147,4 @@ def run_predict_metrics(cfg: DictConfig) -> dict:
         {n: m[named] for n, m in files["maps"].items()},
         titles=[f"Map {k + 1}: {i.map.replace('_', ' ')}" for k, i in enumerate(shown)],
     )
-    return results
+    return out

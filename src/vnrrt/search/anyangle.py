@@ -60,8 +60,7 @@ import math
 import numpy as np
 from numba import njit
 
-from vnrrt.grid import as_occupancy, as_point
-from vnrrt.search.astar import NoPathError
+from vnrrt.grid import NoPathError, as_occupancy, as_point
 from vnrrt.search.heap import heap_new, heap_pop, heap_push
 
 TOL = 1e-9  # pixels: "on a grid line" tolerance of the visibility test

@@ -20,17 +20,14 @@ import math
 import numpy as np
 from numba import njit
 
-from vnrrt.grid import MOVE_COSTS, MOVES, GridError, as_cell, as_occupancy
+from vnrrt.grid import MOVE_COSTS, MOVES, NoPathError, as_cell, as_occupancy
+from vnrrt.search.anyangle import any_angle_path
 from vnrrt.search.heap import heap_new, heap_pop, heap_push
 
 EPS = 1e-7
 _DX = MOVES[:, 0].copy()  # module-level constant arrays, frozen into the numba kernels
 _DY = MOVES[:, 1].copy()
 _COST = MOVE_COSTS.copy()
-
-
-class NoPathError(GridError):
-    """Start and goal are not connected in the 8-connected, no-corner-cutting graph."""
 
 
 @njit(cache=True)
@@ -188,8 +185,6 @@ def guide_for(tie_break: str, grid: np.ndarray, start, goal) -> np.ndarray:
     centres = np.array([start, goal], np.float64) + 0.5
     if tie_break == "line":
         return centres
-    from vnrrt.search.anyangle import any_angle_path
-
     return any_angle_path(grid, centres[0], centres[1])[0]
 
 

@@ -4,11 +4,12 @@ LightningModule factories from ``train``, the callbacks from ``callbacks``, the
 ``lightning.Trainer`` from ``trainer``; as lightning-hydra-template does), then call
 :func:`vnrrt.training.train.fit`.
 
-Outputs: ``<paths.models>/<network>.ckpt`` (with the record of :func:`make_record`),
-``<paths.metrics>/train_<network>.json`` and an MLflow run holding the network as an MLflow
-Model (pytorch flavour, signature, input example), registered as ``vnrrt-<network>``.
+Outputs: ``paths.checkpoint(network)`` (with the record of :func:`make_record`) and its
+sidecar ``.sha256``, ``paths.train_metrics(network)`` and an MLflow run holding the network as
+an MLflow Model (pytorch flavour, signature, input example), registered as
+``vnrrt-<network>``.
 
-**Resuming**: Lightning writes ``<paths.models>/checkpoints/<network>/last.ckpt`` after every
+**Resuming**: Lightning writes ``paths.run_folder(network) / "last.ckpt"`` after every
 epoch. A re-run after a kill resumes from it when it was written with the same settings (its
 record's ``fingerprint``), and says why it restarts otherwise; the folder is removed after a
 successful run. Resuming gives the same weights as an uninterrupted run (tested).
@@ -16,6 +17,7 @@ successful run. Resuming gives the same weights as an uninterrupted run (tested)
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import json
 import logging
@@ -25,32 +27,46 @@ from pathlib import Path
 from omegaconf import DictConfig, OmegaConf
 
 from vnrrt import tracking
+from vnrrt.config import section
+from vnrrt.paths import Paths
 
 log = logging.getLogger(__name__)
 LOGGER_CALLBACKS = ("learning_rate_monitor", "prediction_figures")  # need an MLflow logger
+SETTINGS = ("seed", "model", "train", "trainer", "callbacks")  # what determines the weights
 
 
-def network_spec(cfg: DictConfig, network: str) -> DictConfig:
-    """``networks.<network>`` (target, endpoints, resume); ``KeyError`` lists the known ones."""
+@dataclasses.dataclass
+class NetworkSpec:
+    """``networks.<network>``: its training target (``vertex`` or ``path``), the endpoints
+    it marks, and an explicit checkpoint to resume from (None: an interrupted run's)."""
+
+    target: str
+    endpoints: str
+    resume: str | None
+
+    def validate(self) -> None:
+        pass  # vnrrt.validate checks target and endpoints against the data's known values
+
+
+def _plain(node):
+    """A config node as plain containers (a scalar as itself)."""
+    return OmegaConf.to_container(node, resolve=True) if OmegaConf.is_config(node) else node
+
+
+def network_spec(cfg: DictConfig, network: str) -> NetworkSpec:
+    """``networks.<network>`` typed; ``KeyError`` lists the known ones."""
     if network not in cfg.networks:
         raise KeyError(f"unknown network {network!r}; configured: {sorted(cfg.networks)}")
-    return cfg.networks[network]
+    return section(cfg.networks, network, NetworkSpec)
 
 
-def fingerprint(cfg: DictConfig, network: str) -> str:
-    """sha256 of everything that determines the trained weights: seed, model, train,
-    trainer, callbacks and the network's target (not paths, logger or workers)."""
-    keys = ("seed", "model", "train", "trainer", "callbacks")
-    doc = {
-        k: OmegaConf.to_container(cfg[k], resolve=True)
-        if isinstance(cfg[k], DictConfig)
-        else cfg[k]
-        for k in keys
-        if k in cfg
-    }
-    spec = OmegaConf.to_container(network_spec(cfg, network), resolve=True)
-    doc["network"] = {k: v for k, v in spec.items() if k != "resume"}
-    places = {str(v): f"<paths.{k}>" for k, v in (cfg.get("paths") or {}).items()}
+def fingerprint(settings: dict, spec: NetworkSpec, paths: Paths) -> str:
+    """sha256 of everything that determines the trained weights: ``settings`` (seed, model,
+    train, trainer and callbacks as plain containers) and the network's target (not paths,
+    logger or workers)."""
+    doc = dict(settings)
+    doc["network"] = {"target": spec.target, "endpoints": spec.endpoints}
+    places = {str(v): f"<paths.{k}>" for k, v in dataclasses.asdict(paths).items()}
     return hashlib.sha256(json.dumps(_unplaced(doc, places), sort_keys=True).encode()).hexdigest()
 
 
@@ -68,33 +84,34 @@ def _unplaced(doc, places: dict[str, str]):
     return doc
 
 
-def make_record(cfg: DictConfig, network: str, net) -> dict:
-    """What a checkpoint keeps to rebuild and check its network (plain JSON-able values)."""
-    spec, dm = network_spec(cfg, network), cfg.train.datamodule
+def make_record(network: str, net_config: dict, spec: NetworkSpec, dm: dict, net,
+                fingerprint: str) -> dict:  # fmt: skip
+    """What a checkpoint keeps to rebuild and check its network (plain JSON-able values):
+    ``net_config`` (``model.net``), the target, and the input rendering of the datamodule
+    settings ``dm`` (``train.datamodule``)."""
     return {
         "network": network,
-        "net": OmegaConf.to_container(cfg.model.net, resolve=True),
+        "net": net_config,
         "target": {
             "kind": spec.target,
             "endpoints": spec.endpoints,
-            "radius": float(dm.target_radius),
+            "radius": float(dm["target_radius"]),
         },
-        "render": {"marker_radius": float(dm.marker_radius), "normalize": dm.normalize},
+        "render": {"marker_radius": float(dm["marker_radius"]), "normalize": dm["normalize"]},
         "describe": net.describe() if hasattr(net, "describe") else {},
-        "fingerprint": fingerprint(cfg, network),
+        "fingerprint": fingerprint,
     }
 
 
-def resume_from(cfg: DictConfig, network: str, record: dict) -> Path | None:
-    """The checkpoint to resume from: ``networks.<network>.resume`` if set, else the last
-    checkpoint of an interrupted run with the same settings (module doc), else None."""
+def resume_from(spec: NetworkSpec, paths: Paths, network: str, record: dict) -> Path | None:
+    """The checkpoint to resume from: ``spec.resume`` if set, else the last checkpoint of an
+    interrupted run with the same settings (module doc), else None."""
     from vnrrt.model.checkpoint import CheckpointError, read_checkpoint
     from vnrrt.model.module import RECORD_KEY
 
-    explicit = network_spec(cfg, network).resume
-    if explicit is not None:
-        return Path(explicit)
-    last = Path(cfg.paths.models) / "checkpoints" / network / "last.ckpt"
+    if spec.resume is not None:
+        return Path(spec.resume)
+    last = paths.run_folder(network) / "last.ckpt"
     if not last.is_file():
         return None
     try:
@@ -109,37 +126,38 @@ def resume_from(cfg: DictConfig, network: str, record: dict) -> Path | None:
     return last
 
 
-def build_callbacks(cfg: DictConfig, network: str, with_logger: bool) -> list:
-    """The ``callbacks`` group instantiated; the checkpoint goes to
-    ``<paths.models>/checkpoints/<network>``; logger-only callbacks need a logger."""
+def build_callbacks(callbacks: DictConfig | None, folder: Path, with_logger: bool) -> list:
+    """The ``callbacks`` group instantiated; the checkpoint goes to ``folder``; logger-only
+    callbacks need a logger."""
     from hydra.utils import instantiate
 
     out = []
-    for name, node in (cfg.get("callbacks") or {}).items():
+    for name, node in (callbacks or {}).items():
         if node is None or (name in LOGGER_CALLBACKS and not with_logger):
             continue
-        extra = {}
-        if name == "model_checkpoint":
-            extra["dirpath"] = str(Path(cfg.paths.models) / "checkpoints" / network)
+        extra = {"dirpath": str(folder)} if name == "model_checkpoint" else {}
         out.append(instantiate(node, **extra))
     return out
 
 
-def make_logger(cfg: DictConfig, network: str, record: dict):
-    """The run's ``MLFlowLogger``: experiment per scale, tags, params, the config file."""
+def make_logger(logger_cfg: tracking.LoggerConfig, scale: str, network: str, record: dict,
+                settings: dict, config_text: str):  # fmt: skip
+    """The run's ``MLFlowLogger``: experiment per scale, tags, the flattened ``settings`` and
+    the network's target under common keys (``network.target``, ``network.endpoints``) as
+    params, the run's whole config (``config_text``) as ``config.yaml``."""
     from hydra.utils import instantiate
 
-    uri = tracking.tracking_uri(cfg.logger.uri)
-    scale = str(cfg.scale.name)
-    exp = tracking.experiment_id(cfg.logger.experiment, uri, cfg.logger.artifact_location)
+    uri = tracking.tracking_uri(logger_cfg.uri)
+    exp = tracking.experiment_id(logger_cfg.experiment, uri, logger_cfg.artifact_location)
     tags = tracking.run_tags(network, scale, fingerprint=record["fingerprint"])
     tracking.mark_stale_runs(uri, exp, tags)
     logger = instantiate(
-        cfg.logger.lightning, run_name=f"{network} {scale}", tracking_uri=uri, tags=tags
+        logger_cfg.lightning, run_name=f"{network} {scale}", tracking_uri=uri, tags=tags
     )
-    logger.log_hyperparams(tracking.flat_params(cfg))
+    target = {k: record["target"][k] for k in ("kind", "endpoints", "radius")}
+    logger.log_hyperparams(tracking.flat_params({**settings, "network": target}))
     logger.log_hyperparams({f"net_info.{k}": v for k, v in record["describe"].items()})
-    logger.experiment.log_text(logger.run_id, OmegaConf.to_yaml(cfg), "config.yaml")
+    logger.experiment.log_text(logger.run_id, config_text, "config.yaml")
     return logger
 
 
@@ -167,8 +185,9 @@ def fix_threads(threads: int | None) -> int:
 
 def run_train(cfg: DictConfig, network: str) -> dict:
     """Stage ``train@<network>``: train ``network`` as configured (module doc); returns and
-    writes its metrics."""
-    tracking.configure(cfg.logger.uri)  # before Lightning (and its MLflow logger) is imported
+    writes its metrics. The stage's parameters are read here; below, typed pieces."""
+    logger_cfg = section(cfg, "logger", tracking.LoggerConfig)
+    tracking.configure(logger_cfg.uri)  # before Lightning (and its MLflow logger) is imported
     import lightning as L
     from hydra.utils import instantiate
 
@@ -177,21 +196,26 @@ def run_train(cfg: DictConfig, network: str) -> dict:
     from vnrrt.model.checkpoint import check_checkpoint
     from vnrrt.training.train import fit, resolve_precision
 
-    spec = network_spec(cfg, network)
+    paths, spec = section(cfg, "paths", Paths), network_spec(cfg, network)
+    settings = {k: _plain(cfg[k]) for k in SETTINGS if k in cfg}
     threads = fix_threads(cfg.train.get("threads"))
     L.seed_everything(int(cfg.train.get("seed", cfg.seed)), workers=True)
     datamodule = instantiate(
         cfg.train.datamodule, target=spec.target, target_endpoints=spec.endpoints
     )
     net, loss = instantiate(cfg.model.net), instantiate(cfg.model.loss)
-    record = make_record(cfg, network, net)
+    record = make_record(network, settings["model"]["net"], spec, settings["train"]["datamodule"],
+                         net, fingerprint(settings, spec, paths))  # fmt: skip
     make_module = instantiate(cfg.train.module, _partial_=True)
     module = make_module(net=net, loss=loss, record=record)
-    resume = resume_from(cfg, network, record)
+    resume = resume_from(spec, paths, network, record)
     if resume is not None:
         check_checkpoint(resume, record, module)
-    logger = make_logger(cfg, network, record) if cfg.logger.enabled else None
-    callbacks = build_callbacks(cfg, network, logger is not None)
+    logger = None
+    if logger_cfg.enabled:
+        scale, text = str(cfg.scale.name), OmegaConf.to_yaml(cfg)
+        logger = make_logger(logger_cfg, scale, network, record, settings, text)
+    callbacks = build_callbacks(cfg.get("callbacks"), paths.run_folder(network), logger is not None)
     bar = any(type(c).__name__ == "TQDMProgressBar" for c in callbacks)
     precision = resolve_precision(cfg.trainer.precision, cfg.trainer.accelerator)
     trainer = instantiate(
@@ -202,32 +226,31 @@ def run_train(cfg: DictConfig, network: str) -> dict:
         enable_progress_bar=bar,
         _convert_="all",
     )
-    out = Path(cfg.paths.models) / f"{network}.ckpt"
-    metrics_file = Path(cfg.paths.metrics) / f"train_{network}.json"
-    metrics = fit(
-        module, datamodule, trainer, out, metrics_file, int(cfg.train.datamodule.batch_size), resume
-    )
+    out, metrics_file = paths.checkpoint(network), paths.train_metrics(network)
+    batch = int(cfg.train.datamodule.batch_size)
+    metrics = fit(module, datamodule, trainer, out, metrics_file, batch, resume)
     if trainer.is_global_zero:
         if logger is not None:
             metrics["mlflow_run_id"] = logger.run_id
-            log_model(cfg, network, out, logger, datamodule)
+            log_model(logger_cfg, network, out, logger, datamodule)
         from vnrrt.io import write_json
         from vnrrt.model.checkpoint import write_checksum
 
         metrics["checkpoint_sha256"] = write_checksum(out)
         metrics["threads"] = threads
         write_json(metrics_file, metrics)
-        shutil.rmtree(Path(cfg.paths.models) / "checkpoints" / network, ignore_errors=True)
+        shutil.rmtree(paths.run_folder(network), ignore_errors=True)
     return metrics
 
 
-def log_model(cfg: DictConfig, network: str, checkpoint: Path, logger, datamodule) -> None:
+def log_model(logger_cfg: tracking.LoggerConfig, network: str, checkpoint: Path, logger,
+              datamodule) -> None:  # fmt: skip
     """Log the trained network to the run as an MLflow Model (pytorch flavour) with a
-    signature and an input example, and register it as ``vnrrt-<network>``."""
+    signature and an input example, and register it as ``<registry_prefix><network>``."""
     from vnrrt.io import sha256
 
     logger.experiment.set_tag(logger.run_id, "checkpoint_sha256", sha256(checkpoint))
-    if not cfg.logger.log_model:
+    if not logger_cfg.log_model:
         return
     import mlflow
     import mlflow.pytorch
@@ -236,9 +259,10 @@ def log_model(cfg: DictConfig, network: str, checkpoint: Path, logger, datamodul
 
     net, record = load_network(checkpoint, network)
     example = datamodule.datasets["val"][0]["image"][None].numpy()  # (1, 3, S, S) float32
-    mlflow.set_tracking_uri(tracking.tracking_uri(cfg.logger.uri))
+    mlflow.set_tracking_uri(tracking.tracking_uri(logger_cfg.uri))
     with mlflow.start_run(run_id=logger.run_id):
-        registered = cfg.logger.registry_prefix + network if cfg.logger.registry_prefix else None
+        prefix = logger_cfg.registry_prefix
+        registered = prefix + network if prefix else None
         # pickle: load_model returns the nn.Module itself (any batch size; needs vnrrt installed)
         mlflow.pytorch.log_model(
             net,

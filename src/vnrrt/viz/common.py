@@ -8,6 +8,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
+import matplotlib.text
 import numpy as np
 from matplotlib.colors import ListedColormap, PowerNorm
 from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
@@ -19,10 +20,22 @@ HEAT_CMAP = "Blues"  # white (0) to dark blue (1): start (green) and goal (red) 
 HEAT_NORM_GAMMA = 0.5  # a square-root colour scale, so that faint probabilities show
 
 
+def figure_text(fig) -> str:
+    """Every text a reader sees on ``fig`` (suptitle, titles, axis labels, tick labels,
+    legends, annotations, colour bar labels), one per line, in drawing order."""
+    fig.canvas.draw()  # tick labels exist only once drawn
+    found = [t.get_text() for t in fig.findobj(matplotlib.text.Text)]
+    return "\n".join(dict.fromkeys(t for t in found if t.strip()))
+
+
 def save_figure(fig, out_png: str | Path, dpi: int = 110) -> None:
-    """Save ``fig`` as PNG atomically (temp file + rename) and close it."""
+    """Save ``fig`` as PNG atomically (temp file + rename) and close it. The PNG carries
+    :func:`figure_text` as its ``Description`` (a tEXt chunk), so that tests and readers can
+    check what a figure says without reading pixels."""
+    meta = {"Description": figure_text(fig)}
     atomic_write_bytes(
-        Path(out_png), lambda f: fig.savefig(f, format="png", dpi=dpi, bbox_inches="tight")
+        Path(out_png),
+        lambda f: fig.savefig(f, format="png", dpi=dpi, bbox_inches="tight", metadata=meta),
     )
     plt.close(fig)
 

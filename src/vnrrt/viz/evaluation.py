@@ -8,7 +8,8 @@ from pathlib import Path
 import matplotlib.pyplot as plt
 import numpy as np
 
-from vnrrt.names import STOP_NAMES, display_name, map_set_title, sort_keys
+from vnrrt.evaluation.keys import is_informed, label, sort_texts
+from vnrrt.names import MAP_SETS, level_name, map_set_title, stop_name
 from vnrrt.viz.common import log_ticks, plot_floor_map, plot_heatmap, save_figure
 
 HEATMAP_TITLES = {"nrrtnet": "(c) NRRT* network", "vertexnet": "(d) VertexNet"}
@@ -66,16 +67,13 @@ def save_heatmaps(out_png, *args, **kwargs) -> None:
     save_figure(heatmaps_figure(*args, **kwargs), out_png)
 
 
-def improvements_figure(per_key: dict, stop: str, baseline: str = "RRT*"):
+def improvements_figure(per_key: dict, stop: str, eps: float, level: float, baseline: str = "RRT*"):
     """Fig. 5: improvement over ``baseline`` in % (paired speed-up - 1) per map set, one bar
-    per configuration in the paper's order, whiskers = the CI. ``per_key``: ``{key:
-    {map_set: {"speedup", "ci_low", "ci_high"}}}``. Returns the figure."""
-    keys = sort_keys(k for k in per_key if not k.endswith("+informed"))
-    sets = [
-        m
-        for m in ("map_1", "map_2", "map_3", "map_4", "map_5", "random")
-        if any(m in per_key[k] for k in keys)
-    ]
+    per configuration in the paper's order, whiskers = the CI at ``level``; ``eps``: the
+    stop tolerance. ``per_key``: ``{key: {map_set: {"speedup", "ci_low", "ci_high"}}}``.
+    Returns the figure."""
+    keys = sort_texts(k for k in per_key if not is_informed(k))
+    sets = [m for m in MAP_SETS if any(m in per_key[k] for k in keys)]
     fig, ax = plt.subplots(figsize=(1.7 * len(sets) + 3, 4.0))
     width = 0.8 / max(len(keys), 1)
     for i, key in enumerate(keys):
@@ -91,25 +89,25 @@ def improvements_figure(per_key: dict, stop: str, baseline: str = "RRT*"):
         pct = (vals - 1.0) * 100.0
         xs = np.arange(len(sets)) + (i - (len(keys) - 1) / 2) * width
         err = np.abs(pct[:, 1:].T - pct[:, 0])
-        ax.bar(xs, pct[:, 0], width, yerr=err, capsize=2, label=display_name(key))
+        ax.bar(xs, pct[:, 0], width, yerr=err, capsize=2, label=label(key))
     ax.axhline(0, color="black", lw=0.8)
     ax.set_xticks(np.arange(len(sets)), [map_set_title(m) for m in sets])
     ax.set_ylabel(f"time improvement over {baseline} (%)")
-    ax.set_title(f"Time improvement over {baseline}, {STOP_NAMES.get(stop, stop)}", fontsize=10)
+    ax.set_title(f"Time improvement over {baseline}, {stop_name(stop, eps)}", fontsize=10)
     ax.legend(fontsize=7, ncol=2)
     fig.text(
         0.01,
         -0.04,
         "Bars: geometric mean over instances of median(RRT*) / median(planner)"
-        " - 1; whiskers: 95% CI (bootstrap over base maps, then trials).",
+        f" - 1; whiskers: {level_name(level)} CI (bootstrap over base maps, then trials).",
         fontsize=7,
     )
     return fig
 
 
-def save_improvements(out_png, per_key: dict, stop: str) -> None:
+def save_improvements(out_png, per_key: dict, stop: str, eps: float, level: float) -> None:
     """:func:`improvements_figure` saved as a PNG."""
-    save_figure(improvements_figure(per_key, stop), out_png)
+    save_figure(improvements_figure(per_key, stop, eps, level), out_png)
 
 
 def convergence_figure(curves, names: dict[str, str] | None = None):
@@ -117,11 +115,7 @@ def convergence_figure(curves, names: dict[str, str] | None = None):
     (optimal stop rule, map set), one line per configuration, one shared legend.
     ``curves``: columns stop, planner, map_set, factor, median_time (s). Returns the figure."""
     stops = [s for s in ("optimal", "optimal_any_angle") if s in set(curves["stop"])]
-    sets = [
-        m
-        for m in ("map_1", "map_2", "map_3", "map_4", "map_5", "random")
-        if m in set(curves["map_set"])
-    ]
+    sets = [m for m in MAP_SETS if m in set(curves["map_set"])]
     fig, axes = plt.subplots(
         len(stops),
         len(sets),
@@ -134,10 +128,10 @@ def convergence_figure(curves, names: dict[str, str] | None = None):
         for c, map_set in enumerate(sets):
             ax = axes[r, c]
             sub = curves[(curves["stop"] == stop) & (curves["map_set"] == map_set)]
-            for key in sort_keys(k for k in set(sub["planner"]) if not k.endswith("+informed")):
+            for key in sort_texts(k for k in set(sub["planner"]) if not is_informed(k)):
                 rows = sub[sub["planner"] == key].sort_values("factor", ascending=False)
                 (line,) = ax.plot(rows["median_time"] * 1e3, rows["factor"], "o-", ms=3)
-                handles.setdefault(display_name(key), line)
+                handles.setdefault(label(key), line)
             log_ticks(ax.xaxis)
             ax.set_title(map_set_title(map_set, (names or {}).get(map_set)), fontsize=9)
             ax.set_xlabel("median time (ms)", fontsize=8)

@@ -9,24 +9,31 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 
-from vnrrt.names import INFORMED, STOP_NAMES, display_name
+from vnrrt.evaluation.keys import is_informed, label
+from vnrrt.names import level_name, stop_name
 from vnrrt.viz.common import log_ticks, save_figure
+
+QUALITY_STOPS = ("initial", "optimal", "optimal_any_angle")
 
 IDEA_NAMES = {"oracle_path": "path oracle", "oracle_vertex": "vertex oracle"}
 
 
-def quality_figure(curves: pd.DataFrame, networks: pd.DataFrame, metric: str = "iterations"):
+def quality_figure(
+    curves: pd.DataFrame, networks: pd.DataFrame, settings: dict, metric: str = "iterations"
+):
     """Speed-up over RRT* (log axis, whiskers: CI) against the heatmap's mass near its
     target, one curve per idea and sampler (points: signal fractions q), one panel per stop
-    rule; the trained networks as labelled stars at their own measured mass. Returns it."""
-    stops = [s for s in STOP_NAMES if s in set(curves["stop"])]
+    rule; the trained networks as labelled stars at their own measured mass. ``settings``:
+    the study's ``eps``, ``level`` and mass ``radius`` (px), named on the figure. Returns it."""
+    eps = settings["eps"]
+    stops = [s for s in QUALITY_STOPS if s in set(curves["stop"])]
     fig, axes = plt.subplots(1, len(stops), figsize=(4.6 * len(stops), 4.2), squeeze=False)
     for ax, stop in zip(axes[0], stops, strict=True):
         sub = curves[(curves["stop"] == stop) & (curves["metric"] == metric)]
         for (idea, conf), rows in sub.groupby(["idea", "configuration"], sort=False):
             rows = rows.sort_values("heat_mass")
             err = [rows["speedup"] - rows["ci_low"], rows["ci_high"] - rows["speedup"]]
-            label = f"{display_name(conf)}, {IDEA_NAMES.get(idea, idea)}"
+            name = f"{label(conf)}, {IDEA_NAMES.get(idea, idea)}"
             ax.errorbar(
                 rows["heat_mass"],
                 rows["speedup"],
@@ -34,11 +41,11 @@ def quality_figure(curves: pd.DataFrame, networks: pd.DataFrame, metric: str = "
                 marker="o",
                 ms=3,
                 capsize=2,
-                label=label,
+                label=name,
             )
         nets = networks[(networks["stop"] == stop) & (networks["metric"] == metric)]
         # the curves are plain (not informed) samplers: informed networks are not on them
-        nets = nets[~nets["configuration"].str.endswith(INFORMED)].sort_values("speedup")
+        nets = nets[~nets["configuration"].map(is_informed).astype(bool)].sort_values("speedup")
         placed: list[float] = []  # log10 heights of the labels so far: close ones stacked
         for _, row in nets.iterrows():
             ax.plot(row["heat_mass"], row["speedup"], "*", ms=12, color="black")
@@ -46,7 +53,7 @@ def quality_figure(curves: pd.DataFrame, networks: pd.DataFrame, metric: str = "
             lift = sum(abs(y - other) < 0.05 for other in placed)
             placed.append(y)
             ax.annotate(
-                display_name(row["configuration"]),
+                label(row["configuration"]),
                 (row["heat_mass"], row["speedup"]),
                 fontsize=7,
                 xytext=(4, 4 + 9 * lift),
@@ -55,24 +62,27 @@ def quality_figure(curves: pd.DataFrame, networks: pd.DataFrame, metric: str = "
         ax.axhline(1.0, color="grey", lw=0.8)
         log_ticks(ax.xaxis)
         log_ticks(ax.yaxis)
-        ax.set_xlabel("heatmap mass within 3 px of its target")
-        ax.set_title(STOP_NAMES[stop], fontsize=9)
+        ax.set_xlabel(f"heatmap mass within {settings['radius']:g} px of its target")
+        ax.set_title(stop_name(stop, eps), fontsize=9)
     axes[0, 0].set_ylabel(f"speed-up over RRT* ({metric.replace('time_to_stop', 'time')})")
     handles, labels = axes[0, 0].get_legend_handles_labels()
     fig.legend(handles, labels, loc="lower center", ncol=3, fontsize=7, bbox_to_anchor=(0.5, -0.08))
     fig.suptitle(
         "How good must a heatmap be? Speed-up against heatmap quality "
-        "(points: signal fraction q; stars: the trained networks; whiskers: 95% CI)",
+        "(points: signal fraction q; stars: the trained networks; whiskers: "
+        f"{level_name(settings['level'])} CI)",
         fontsize=9,
     )
     fig.tight_layout(rect=(0, 0.05, 1, 1))
     return fig
 
 
-def regime_figure(cells: pd.DataFrame, stop: str, eps: float = 0.01):
+def regime_figure(cells: pd.DataFrame, stop: str, settings: dict):
     """Speed-up over RRT* per regime cell (rows) and configuration (columns), log colour
-    scale, ``*`` where the CI excludes 1. Returns the figure."""
-    sub = cells[(cells["stop"] == stop) & (cells["eps"] == eps)]
+    scale, ``*`` where the CI excludes 1; ``settings``: the study's ``eps`` and ``level``.
+    Returns the figure."""
+    eps = settings["eps"]
+    sub = cells[cells["stop"] == stop]
     regimes = list(dict.fromkeys(sub["regime"]))
     confs = list(dict.fromkeys(sub["configuration"]))
     grid = np.full((len(regimes), len(confs)), np.nan)
@@ -89,26 +99,24 @@ def regime_figure(cells: pd.DataFrame, stop: str, eps: float = 0.01):
             if np.isfinite(grid[i, j]):
                 text = f"{2 ** grid[i, j]:.2f}{'*' if sig[i, j] else ''}"
                 ax.text(j, i, text, ha="center", va="center", fontsize=7)
-    ax.set_xticks(
-        range(len(confs)), [display_name(c) for c in confs], rotation=30, ha="right", fontsize=7
-    )
+    ax.set_xticks(range(len(confs)), [label(c) for c in confs], rotation=30, ha="right", fontsize=7)
     ax.set_yticks(range(len(regimes)), regimes, fontsize=7)
     bar = fig.colorbar(image, ax=ax)
     bar.set_label("log2 speed-up over RRT* (blue: faster)")
     ax.set_title(
-        f"Time speed-up over RRT*, {STOP_NAMES.get(stop, stop)} (eps {eps:g}); "
-        "* = 95% CI excludes 1",
+        f"Time speed-up over RRT*, {stop_name(stop, eps)} (eps {eps:g}); "
+        f"* = {level_name(settings['level'])} CI excludes 1",
         fontsize=9,
     )
     fig.tight_layout()
     return fig
 
 
-def save_quality(out_png: str | Path, curves, networks, metric: str = "iterations") -> None:
+def save_quality(out_png: str | Path, curves, networks, settings: dict) -> None:
     """:func:`quality_figure` saved as a PNG."""
-    save_figure(quality_figure(curves, networks, metric), out_png)
+    save_figure(quality_figure(curves, networks, settings), out_png)
 
 
-def save_regime(out_png: str | Path, cells, stop: str, eps: float = 0.01) -> None:
+def save_regime(out_png: str | Path, cells, stop: str, settings: dict) -> None:
     """:func:`regime_figure` saved as a PNG."""
-    save_figure(regime_figure(cells, stop, eps), out_png)
+    save_figure(regime_figure(cells, stop, settings), out_png)

@@ -11,11 +11,10 @@ from vnrrt.names import map_set_title
 from vnrrt.viz.common import plot_floor_map, save_figure
 
 
-def save_named_maps(shard_path: str | Path, out_png: str | Path) -> None:
-    """Fig. 4 from a named-maps shard file, saved as a PNG (:func:`named_maps_figure`)."""
-    from vnrrt.data.reader import Shard
-
-    save_figure(named_maps_figure(Shard(shard_path)), out_png)
+def save_named_maps(shard, out_png: str | Path) -> None:
+    """Fig. 4 from the named maps (a :class:`~vnrrt.data.reader.Shard`), saved as a PNG
+    (:func:`named_maps_figure`)."""
+    save_figure(named_maps_figure(shard), out_png)
 
 
 def named_maps_figure(shard):

@@ -6,7 +6,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.collections import LineCollection
 
-from vnrrt.names import display_name
+from vnrrt.names import PLANNER_NAMES
 from vnrrt.viz.common import draw_obstacles, frame_axes, mark_endpoints, save_figure
 
 
@@ -28,7 +28,7 @@ def plot_plan(ax, grid, result, start, goal, heatmap=None, title=None):
     if len(result.path):
         ax.plot(result.path[:, 0], result.path[:, 1], "-", color="tab:red", lw=1.8)
     mark_endpoints(ax, start, goal, centres=False)
-    name = display_name(result.planner)
+    name = PLANNER_NAMES.get(result.planner, result.planner)
     default = f"{name}: cost {result.cost:.1f} px, {result.iterations} iterations"
     frame_axes(ax, (h, w), title or default)
 
@@ -44,7 +44,7 @@ def save_plan(out_png, grid, result, start, goal, heatmap=None, title=None) -> N
 def plot_cost_traces(ax, results, labels=None):
     """Best path cost (px) versus iteration from the sparse traces of planner results."""
     for i, r in enumerate(results):
-        label = labels[i] if labels is not None else display_name(r.planner)
+        label = labels[i] if labels is not None else PLANNER_NAMES.get(r.planner, r.planner)
         ax.step(r.trace_iterations, r.trace_costs, where="post", label=label)
     ax.set_xlabel("iteration")
     ax.set_ylabel("best path cost (px)")

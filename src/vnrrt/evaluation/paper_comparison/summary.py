@@ -1,28 +1,21 @@
 """Everything the report says, computed once from the merged trial table (stage
 ``evaluate``): per-cell summaries, paired speed-ups, the paper's claims with verdicts and
 convergence curves. The result is plain JSON-able data (``paths.summary``,
-``data/<scale>/summary.json``); :mod:`vnrrt.evaluation.report` only renders it.
+``data/<scale>/summary.json``); :mod:`vnrrt.evaluation.paper_comparison.report` only
+renders it.
 """
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pandas as pd
-import yaml
 
-from vnrrt.evaluation.protocol import INFORMED, STOPS
+from vnrrt.evaluation.keys import ConfigKey
+from vnrrt.evaluation.protocol import STOPS
 from vnrrt.evaluation.stats import Summary, bonferroni_level, compare, summarize, verdict
 from vnrrt.evaluation.table import CONVERGENCE_COLUMNS, CONVERGENCE_FACTORS
 
 METRICS = {"time_to_stop": True, "iterations": True, "cost": False}  # metric -> censored
-
-
-def load_paper_tables(path: str | Path) -> dict:
-    """The paper's numbers (``reports/paper/tables.yaml``: tables, quoted claims)."""
-    with open(path) as f:
-        return yaml.safe_load(f)
 
 
 def _summary(sub: pd.DataFrame, metric: str, n_boot: int, level: float) -> Summary:
@@ -37,7 +30,7 @@ def _summary(sub: pd.DataFrame, metric: str, n_boot: int, level: float) -> Summa
     )
 
 
-def cells(table: pd.DataFrame, n_boot: int = 2000, level: float = 0.95) -> dict:
+def cells(table: pd.DataFrame, n_boot: int, level: float) -> dict:
     """``{stop: {key: {map_set: {metric: Summary dict}}}}`` for time, iterations and cost."""
     out: dict = {}
     for (stop, key, map_set), sub in table.groupby(["stop", "key", "map_set"], sort=False):
@@ -50,9 +43,9 @@ def cells(table: pd.DataFrame, n_boot: int = 2000, level: float = 0.95) -> dict:
 def speedups(
     table: pd.DataFrame,
     baseline: str,
-    metric: str = "time_to_stop",
-    n_boot: int = 2000,
-    level: float = 0.95,
+    metric: str,
+    n_boot: int,
+    level: float,
 ) -> dict:
     """``{stop: {key: {map_set: Comparison dict}}}`` of every configuration against
     ``baseline`` on the same instances."""
@@ -76,7 +69,7 @@ def _claim_pair(table: pd.DataFrame, paper: dict, claim: dict):
     return None if base.empty or plan.empty else (base, plan)
 
 
-def claims(table: pd.DataFrame, paper: dict, n_boot: int = 2000, level: float = 0.95) -> dict:
+def claims(table: pd.DataFrame, paper: dict, n_boot: int, level: float) -> dict:
     """The paper's quoted improvements against ours, for time and iterations: our paired
     speed-up and ratio of means with CIs, the verdict at ``level`` and at the
     Bonferroni-corrected level over all tested (claim, metric) pairs, and whether the map
@@ -106,14 +99,16 @@ def convergence_curves(table: pd.DataFrame, eps: float) -> pd.DataFrame:
     """Median time (s) at which the best cost first fell to ``factor`` x reference, per
     optimal stop rule, configuration and map set, over all trials; a bound a trial never
     reached enters at the trial's stop time (censored, a lower bound). The last point,
-    factor ``1 + eps``, is the stop rule. Columns: stop, planner, map_set, factor,
-    median_time."""
+    factor ``1 + eps``, is the stop rule (factors at or below it are reached at the stop or
+    never, and left out). Columns: stop, planner, map_set, factor, median_time."""
     rows = []
     opt = table[table["stop"] != "initial"]
     for (stop, key, map_set), sub in opt.groupby(["stop", "key", "map_set"], sort=False):
         stop_t = sub["time_to_stop"].to_numpy()
         cols = [*CONVERGENCE_COLUMNS, "time_to_stop"]
         for f, col in zip([*CONVERGENCE_FACTORS, 1.0 + eps], cols, strict=True):
+            if f <= 1.0 + eps and col != "time_to_stop":
+                continue
             t = sub[col].to_numpy()
             median = float(np.median(np.where(np.isnan(t), stop_t, t)))
             rows.append(
@@ -128,20 +123,20 @@ def convergence_curves(table: pd.DataFrame, eps: float) -> pd.DataFrame:
     return pd.DataFrame(rows, columns=["stop", "planner", "map_set", "factor", "median_time"])
 
 
-def informed_comparisons(table: pd.DataFrame, n_boot: int = 2000, level: float = 0.95) -> dict:
+def informed_comparisons(table: pd.DataFrame, n_boot: int, level: float) -> dict:
     """``{stop: {key: {metric: {"vs_informed_rrt": ..., "vs_uninformed": ...}}}}``: each
     informed configuration on the random instances against Informed RRT* (does the learned
     sampler help on top of informed sampling?) and against itself without informed sampling
     (what informed sampling adds). Paired comparisons (:func:`compare`)."""
     out: dict = {}
     rand = table[table["map_set"] == "random"]
-    base_key = "rrt_star" + INFORMED
+    base_key = ConfigKey("rrt_star", informed=True).text
     for stop, sub in rand.groupby("stop", sort=False):
-        keys = [k for k in dict.fromkeys(sub["key"]) if k.endswith(INFORMED)]
+        keys = [k for k in dict.fromkeys(sub["key"]) if ConfigKey.parse(k).informed]
         base = sub[sub["key"] == base_key]
         for key in keys:
             plan = sub[sub["key"] == key]
-            plain = sub[sub["key"] == key.removesuffix(INFORMED)]
+            plain = sub[sub["key"] == ConfigKey.parse(key).with_informed(False).text]
             cell = {}
             for m in ("time_to_stop", "iterations"):
                 vs = {}
@@ -158,14 +153,15 @@ def informed_comparisons(table: pd.DataFrame, n_boot: int = 2000, level: float =
     return out
 
 
-def analyze(
-    table: pd.DataFrame, paper: dict, eps: float, n_boot: int = 2000, level: float = 0.95
-) -> dict:
-    """The whole summary (module doc) of a merged trial table."""
+def analyze(table: pd.DataFrame, paper: dict, eps: float, n_boot: int, level: float) -> dict:
+    """The whole summary (module doc) of a merged trial table, with the settings its numbers
+    were computed with (stop tolerance ``eps``, ``n_boot`` resamples, CI ``level``)."""
     stops = [s for s in STOPS if s in set(table["stop"])]
     keys = list(dict.fromkeys(table["key"]))
     return {
         "eps": eps,
+        "level": level,
+        "bootstrap": n_boot,
         "stops": stops,
         "keys": keys,
         "map_sets": list(dict.fromkeys(table["map_set"])),

@@ -1,6 +1,8 @@
-"""Oracle heatmaps: what a perfect network could tell each sampler, built from the labels.
+"""Heatmap sources: what a learned planner samples. A source is a trained network (its
+predicted heatmap, read from the prediction files into :attr:`EvalInstance.heatmaps`) or an
+oracle: what a perfect network could tell each sampler, built from the labels.
 
-Kinds (``start``/``goal`` are integer cells as in :func:`vnrrt.search.astar`):
+Oracle kinds (``start``/``goal`` are integer cells as in :func:`vnrrt.search.astar`):
 
 * ``oracle_path``: the cells of the A* path (what the NRRT* network learns);
 * ``oracle_vertex``: the interior vertices of the A* path (the paper's turning points,
@@ -34,7 +36,7 @@ import numpy as np
 from vnrrt.grid import as_cell, as_occupancy, cell_center
 from vnrrt.search import any_angle_path, astar, path_vertices
 
-KINDS = (
+ORACLE_KINDS = (
     "oracle_path",
     "oracle_vertex",
     "oracle_vertex_endpoints",
@@ -90,8 +92,8 @@ def target_image(
     """The unblurred target of ``kind`` as an ``(H, W)`` float64 weight image, from an A*
     ``path`` (T+1, 2) cells, its ``vertices`` (K, 2) cells (start and goal included; computed
     from the path when None) and the exact optimum's turning points ``exact_path`` (Q, 2)."""
-    if kind not in KINDS:
-        raise ValueError(f"unknown oracle {kind!r}; known: {KINDS}")
+    if kind not in ORACLE_KINDS:
+        raise ValueError(f"unknown oracle {kind!r}; known: {ORACLE_KINDS}")
     img = np.zeros(shape)
     if kind in ("oracle_taut_path", "oracle_taut_vertex"):
         pts = np.asarray(exact_path, np.float64)
@@ -156,11 +158,19 @@ def mix(heatmap: np.ndarray, grid: np.ndarray, q: float) -> np.ndarray:
     return (out / out.max()).astype(np.float32)
 
 
+ORACLE_PREFIX = "oracle_"
+
+
+def is_oracle(source: str | None) -> bool:
+    """Whether a heatmap source is an oracle (else a network, or None: uniform)."""
+    return source is not None and source.startswith(ORACLE_PREFIX)
+
+
 def parse_source(source: str) -> tuple[str, float]:
     """``oracle_vertex`` -> ``("oracle_vertex", 1.0)``; ``oracle_vertex@q0.1`` -> q = 0.1."""
     kind, _, q = source.partition("@q")
-    if kind not in KINDS:
-        raise ValueError(f"unknown oracle source {source!r}; kinds: {KINDS}")
+    if kind not in ORACLE_KINDS:
+        raise ValueError(f"unknown oracle source {source!r}; kinds: {ORACLE_KINDS}")
     return kind, float(q) if q else 1.0
 
 
@@ -211,3 +221,24 @@ def mass_near(heatmap: np.ndarray, mask: np.ndarray, radius: float) -> float:
     if not mask.any() or total <= 0:
         return math.nan
     return float(h[dilate(mask, radius)].sum() / total)
+
+
+def source_heatmap(source: str, inst, sigma: float | None, floor: float | None) -> np.ndarray:
+    """The heatmap a job samples: a network's (on the instance) or an oracle's (built with
+    blur ``sigma`` px and uniform ``floor``, which an oracle needs), ``(H, W)``."""
+    if source in inst.heatmaps:
+        return inst.heatmaps[source]
+    if is_oracle(source):
+        if sigma is None or floor is None:
+            raise ValueError(f"oracle source {source!r} needs oracle.sigma and oracle.floor")
+        return instance_heatmap(source, inst, sigma, floor)
+    known = sorted(inst.heatmaps)
+    raise KeyError(f"instance {inst.map} has no {source!r} heatmap (known: {known})")
+
+
+def source_target(source: str, network_targets: dict[str, str]) -> str:
+    """The target a source's heatmap aims at (for ``heat_mass``): an oracle's, or the
+    network's (``network_targets``; ``'path'`` or ``'interior_vertices'``)."""
+    if is_oracle(source):
+        return TARGET[parse_source(source)[0]]
+    return network_targets.get(source, "path")

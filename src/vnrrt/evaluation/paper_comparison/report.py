@@ -1,7 +1,9 @@
 """``paper_comparison.md``: the paper's Tables 1-3 beside ours, its quoted claims with our
 verdicts, and how to read both. A renderer only: every number comes from the summary of
-:func:`vnrrt.evaluation.analysis.analyze` and the paper's numbers from
-``reports/paper/tables.yaml`` (data, never typed in here).
+:func:`vnrrt.evaluation.paper_comparison.summary.analyze` (with the settings it was computed
+with: tolerance, CI level, resamples), the networks' metrics with the settings of
+``predict``, and the paper's numbers from ``reports/paper/tables.yaml`` (data, never typed in
+here).
 
 Cells are plain text on one line (no HTML), so the file reads the same on GitHub, in a
 terminal and in MLflow's artifact viewer.
@@ -10,15 +12,65 @@ terminal and in MLflow's artifact viewer.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
-from vnrrt.names import INFORMED, display_name, sort_keys
+from vnrrt.evaluation.keys import ConfigKey, is_informed, label, sort_texts
 from vnrrt.names import MAP_SET_NAMES as COLUMN_NAMES
+from vnrrt.names import level_name, percent, stop_title
 
-STOP_TITLES = {
-    "initial": "initial solution",
-    "optimal": "cost <= (1 + eps) x A* length (the paper's optimal solution)",
-    "optimal_any_angle": "cost <= (1 + eps) x exact continuous optimum (stricter; ours)",
-}
+
+@dataclass(frozen=True)
+class MetricSettings:
+    """How the networks' heatmap metrics were computed (``predict``): "near" within
+    ``radius`` px, recall at probability ``tau``, AP against targets dilated by
+    ``ap_radius`` px with start/goal disks of ``endpoint_radius`` px left out."""
+
+    radius: float
+    tau: float
+    ap_radius: float
+    endpoint_radius: float
+
+
+def metric_settings(settings: dict) -> MetricSettings:
+    """The :class:`MetricSettings` that ``predict.json`` records (its ``settings``)."""
+    keys = ("radius", "tau", "ap_radius", "endpoint_radius")
+    return MetricSettings(*(float(settings[k]) for k in keys))
+
+
+VERDICT_GROUPS = ("reproduced", "same direction", "not reproduced", "reversed")
+TARGET_MASKS = {"vertex": "interior", "path": "path"}  # what each network target is for
+
+
+def headline(summary: dict, networks: dict) -> dict:
+    """A dozen numbers for ``dvc metrics show``: each network's mass near what it is for (a
+    vertex network: the interior vertices; a path network: the path) as a multiple of a
+    uniform map's, the vertex networks' interior-vertex AP, the median planning time (ms) to
+    the A*-relative optimum on random maps per configuration, and the counts of verdicts on
+    the paper's claims. ``networks``: ``predict.json``'s metrics per network."""
+    out: dict = {"mass_x_uniform": {}, "opt_ms": {}, "verdicts": {}}
+    out["interior_ap"] = {}
+    for net, m in networks.items():
+        target = TARGET_MASKS[m["target"]]
+        share, uniform = (
+            m.get(f"test/mass_near_{target}"),
+            m.get(f"test/mass_near_{target}_uniform"),
+        )
+        if share is not None and uniform:
+            out["mass_x_uniform"][net] = round(share / uniform, 3)
+        if "test/interior_ap" in m and m["target"] == "vertex":
+            out["interior_ap"][net] = round(m["test/interior_ap"], 4)
+    for text, sets in summary["cells"].get("optimal", {}).items():
+        s = sets.get("random", {}).get("time_to_stop")
+        key = ConfigKey.parse(text)
+        if s is not None and not key.informed:
+            out["opt_ms"][key.short] = round(1e3 * s["median"], 3)
+    rows = summary["claims"]["rows"]
+    verdicts = [r[m]["verdict"] for r in rows for m in ("time_to_stop", "iterations") if r[m]]
+    for group in VERDICT_GROUPS:
+        out["verdicts"][group.replace("same direction", "same_dir").replace(" ", "_")] = sum(
+            v.startswith(group) for v in verdicts
+        )
+    return out
 
 
 def _num(v: float, digits: int = 3) -> str:
@@ -51,7 +103,7 @@ def table(summary: dict, spec: dict, columns: list[str], metric: str, unit: floa
     stop = spec["stop"]
     rows = spec.get("rows", {}) if metric == spec.get("metric") else {}
     ours = summary["cells"].get(stop, {})
-    paper_keys = [k for k in sort_keys(summary["keys"]) if not k.endswith(INFORMED)]
+    paper_keys = [k for k in sort_texts(summary["keys"]) if not is_informed(k)]
     keys = list(rows) + [k for k in paper_keys if k not in rows]
     lines = [
         "| configuration | source | " + " | ".join(COLUMN_NAMES.get(c, c) for c in columns) + " |",
@@ -60,13 +112,11 @@ def table(summary: dict, spec: dict, columns: list[str], metric: str, unit: floa
     for key in keys:
         if key in rows:
             lines.append(
-                f"| {display_name(key)} | paper | "
-                + " | ".join(_paper(v) for v in rows[key])
-                + " |"
+                f"| {label(key)} | paper | " + " | ".join(_paper(v) for v in rows[key]) + " |"
             )
         if key in ours:
             got = [cell(ours[key].get(c, {}).get(metric), unit) for c in columns]
-            lines.append(f"| {display_name(key)} | ours | " + " | ".join(got) + " |")
+            lines.append(f"| {label(key)} | ours | " + " | ".join(got) + " |")
     return "\n".join(lines)
 
 
@@ -77,13 +127,13 @@ def optima_table(paper: dict, optima: dict) -> str:
     head = "| | " + " | ".join(COLUMN_NAMES.get(c, c) for c in cols) + " |"
     lines = [head, "|" + " --- |" * (len(cols) + 1)]
     lines.append("| paper: optimal length | " + " | ".join(f"{v:.2f}" for v in opt) + " |")
-    for label, field in (
+    for name, field in (
         ("ours: A* optimum", "astar"),
         ("ours: exact continuous optimum", "exact"),
         ("ours: taut A* path (approximation)", "taut"),
     ):
         vals = [optima.get(c, {}).get(field) for c in cols]
-        lines.append(f"| {label} | " + " | ".join(_num(v, 5) for v in vals) + " |")
+        lines.append(f"| {name} | " + " | ".join(_num(v, 5) for v in vals) + " |")
     return "\n".join(lines)
 
 
@@ -126,9 +176,10 @@ def multiple_note(claims: dict) -> str:
         if c is not None and c["verdict"] != c["bonferroni_verdict"]
     ]
     text = (
-        f"{claims['tests']} (claim, metric) pairs are tested at {claims['level']:.0%} each. "
+        f"{claims['tests']} (claim, metric) pairs are tested at "
+        f"{level_name(claims['level'])} each. "
         f"With a Bonferroni correction (each CI at {claims['bonferroni_level']:.2%}, "
-        f"family-wise {claims['level']:.0%}), "
+        f"family-wise {level_name(claims['level'])}), "
     )
     if not changed:
         return text + "no verdict changes."
@@ -143,7 +194,7 @@ def speedup_table(speedups: dict, stop: str, columns: list[str]) -> str:
         "|" + " --- |" * (len(columns) + 1),
     ]
     for key, sets in per_key.items():
-        if key.endswith(INFORMED):
+        if is_informed(key):
             continue  # their own section
         vals = []
         for c in columns:
@@ -151,7 +202,7 @@ def speedup_table(speedups: dict, stop: str, columns: list[str]) -> str:
             vals.append(
                 "—" if s is None else f"{s['speedup']:.2f}x [{s['ci_low']:.2f}, {s['ci_high']:.2f}]"
             )
-        lines.append(f"| {display_name(key)} | " + " | ".join(vals) + " |")
+        lines.append(f"| {label(key)} | " + " | ".join(vals) + " |")
     return "\n".join(lines)
 
 
@@ -164,7 +215,7 @@ def inference_table(summary: dict, inference_ms: dict[str, float], sources: dict
     ]
     for stop in ("initial", "optimal"):
         for key, sets in summary["cells"].get(stop, {}).items():
-            if key.endswith(INFORMED):
+            if is_informed(key):
                 continue
             s = sets.get("random", {}).get("time_to_stop")
             if s is None:
@@ -173,10 +224,15 @@ def inference_table(summary: dict, inference_ms: dict[str, float], sources: dict
             inf = inference_ms.get(net, 0.0) if net else 0.0
             plan_ms = 1e3 * s["median"]
             lines.append(
-                f"| {display_name(key)} | {stop} | {_num(plan_ms)} | "
+                f"| {label(key)} | {stop} | {_num(plan_ms)} | "
                 f"{_num(inf) if net else '0 (no network)'} | {_num(plan_ms + inf)} |"
             )
     return "\n".join(lines)
+
+
+def rules(level: float, bootstrap: int) -> str:
+    """How to read the tables (CIs at ``level`` from ``bootstrap`` resamples)."""
+    return RULES.format(level=level_name(level), bootstrap=f"{bootstrap:,}")
 
 
 RULES = """How to read the tables:
@@ -191,8 +247,9 @@ RULES = """How to read the tables:
   tau, so M-VNRRT* sampled uniformly (it was RRT* then).
 - Comparisons are paired: every configuration runs on the same instances with the same trial
   seeds. A speed-up is the geometric mean over instances of median(baseline) /
-  median(planner); its CI resamples base maps (instances of one map are not independent),
-  then trials within each instance. The paper's ratio of means is shown beside it.
+  median(planner); its {level} CI ({bootstrap} bootstrap resamples) resamples base maps
+  (instances of one map are not independent), then instances, then trials within each
+  instance. The paper's ratio of means is shown beside it.
 - Verdicts: "reproduced" = same sign and the paper's value inside our CI; "same direction,
   smaller/larger effect" = the CI excludes zero on the paper's side but not its value;
   "not reproduced" = the CI contains zero (no effect shown); "reversed" = the CI excludes
@@ -209,18 +266,18 @@ def informed_section(summary: dict) -> str:
     for stop, per_key in summary.get("informed", {}).items():
         cells = summary["cells"].get(stop, {})
         lines = [
-            f"### {STOP_TITLES[stop]}",
+            f"### {stop_title(stop, summary['eps'])}",
             "",
             "| configuration | median ms | median iterations | time vs Informed RRT* | "
             "iterations vs Informed RRT* | time vs not informed |",
             "|" + " --- |" * 6,
         ]
-        for key in sort_keys(per_key):
+        for key in sort_texts(per_key):
             c = cells.get(key, {}).get("random", {})
             t, it = c.get("time_to_stop"), c.get("iterations")
             vs = per_key[key]
             lines.append(
-                f"| {display_name(key)} | {_num(1e3 * t['median']) if t else '—'} | "
+                f"| {label(key)} | {_num(1e3 * t['median']) if t else '—'} | "
                 f"{_num(it['median']) if it else '—'} | "
                 f"{_speed(vs['time_to_stop'].get('vs_informed_rrt'))} | "
                 f"{_speed(vs['iterations'].get('vs_informed_rrt'))} | "
@@ -265,8 +322,9 @@ def networks_table(networks: dict[str, dict]) -> str:
     return "\n".join(lines)
 
 
-def networks_section(networks: dict[str, dict]) -> list[str]:
-    """The report's section on what the networks learnt (empty without metrics)."""
+def networks_section(networks: dict[str, dict], ms: MetricSettings) -> list[str]:
+    """The report's section on what the networks learnt (empty without metrics), with the
+    settings ``ms`` the metrics were computed with."""
     if not networks:
         return []
     return [
@@ -275,13 +333,24 @@ def networks_section(networks: dict[str, dict]) -> list[str]:
         networks_table(networks),
         "",
         "Interior: the A* label's vertices other than start and goal (what a vertex sampler "
-        "should find; the start and goal are drawn in the input). Recall at probability 0.5 "
-        "within 3 px; AP over pixels against the interior vertices (path cells), each dilated "
-        "by 1 px, the start/goal disks left out of the interior AP; 'mass near': the share of "
-        "the heatmap within 3 px, beside a uniform map's; the tau columns after M-VNRRT*'s "
-        "mask (an image left empty counts as uniform).",
+        f"should find; the start and goal are drawn in the input). Recall at probability "
+        f"{ms.tau:g} within {ms.radius:g} px; AP over pixels against the interior vertices "
+        f"(path cells), each dilated by {ms.ap_radius:g} px, the start/goal disks (radius "
+        f"{ms.endpoint_radius:g} px) left out of the interior AP; 'mass near': the share of "
+        f"the heatmap within {ms.radius:g} px, beside a uniform map's; the tau columns after "
+        "M-VNRRT*'s mask (an image left empty counts as uniform).",
         "",
     ]
+
+
+def shorter_range(optima: dict) -> str:
+    """How much shorter the exact optimum is than the A* optimum, over the map sets:
+    ``2-8%``."""
+    gaps = [1 - o["exact"] / o["astar"] for o in optima.values() if o.get("astar")]
+    if not gaps:
+        return "n/a"
+    lo, hi = math.floor(100 * min(gaps)), math.ceil(100 * max(gaps))
+    return f"{lo}%" if lo == hi else f"{lo}-{hi}%"
 
 
 def build_report(
@@ -291,10 +360,11 @@ def build_report(
     inference_ms: dict[str, float],
     sources: dict[str, str],
     scale: str,
-    networks: dict[str, dict] | None = None,
+    networks: dict[str, dict],
+    metric_settings: MetricSettings,
 ) -> str:
     """The whole ``paper_comparison.md`` text; ``networks``: the heatmap metrics of
-    ``predict.json`` per network."""
+    ``predict.json`` per network, computed with ``metric_settings``."""
     cols = paper["columns"]
     eps = summary["eps"]
     parts = [
@@ -304,7 +374,7 @@ def build_report(
         "network would give each sampling idea, and in which planner regime: "
         "[sampling_ideas.md](sampling_ideas.md).",
         "",
-        RULES,
+        rules(summary["level"], summary["bootstrap"]),
         "",
         "## The paper's quoted improvements",
         "",
@@ -318,8 +388,9 @@ def build_report(
         "",
         "The paper's 'optimal' is its A* length. Ours is A* on the 8-connected grid without "
         "corner cutting, between cell centres; the exact continuous optimum (shortest path "
-        "among closed obstacle cells, through convex obstacle corners) is 2-8% shorter, so "
-        "'1% of A*' is a loose target for a continuous planner.",
+        f"among closed obstacle cells, through convex obstacle corners) is {shorter_range(optima)} "
+        "shorter, so "
+        f"'{percent(eps)} of A*' is a loose target for a continuous planner.",
         "",
     ]
     for spec in paper["tables"].values():
@@ -334,7 +405,7 @@ def build_report(
     if "optimal_any_angle" in summary["stops"]:
         spec = {"stop": "optimal_any_angle"}
         parts += [
-            "## Time to within (1 + eps) of the exact continuous optimum (ms; ours, not "
+            f"## Time to within {percent(eps)} of the exact continuous optimum (ms; ours, not "
             "in the paper)",
             "",
             table(summary, spec, cols, "time_to_stop", 1e3),
@@ -342,14 +413,14 @@ def build_report(
         ]
     for stop in summary["stops"]:
         parts += [
-            f"## Iterations, {STOP_TITLES[stop]} (ours; not in the paper)",
+            f"## Iterations, {stop_title(stop, eps)} (ours; not in the paper)",
             "",
             table(summary, {"stop": stop}, cols, "iterations"),
             "",
         ]
     for stop in summary["stops"]:
         parts += [
-            f"## Paired speed-up over RRT*, time, {STOP_TITLES[stop]}",
+            f"## Paired speed-up over RRT*, time, {stop_title(stop, eps)}",
             "",
             speedup_table(summary["over_rrt_star"]["time_to_stop"], stop, cols),
             "",
@@ -361,12 +432,13 @@ def build_report(
             "",
             "Every configuration again with informed sampling (Gammell et al. 2014: once a "
             "solution exists, samples inside the ellipse of shorter paths; nodes that cannot "
-            "improve it skipped), on the random instances; paired speed-ups with 95% CIs.",
+            "improve it skipped), on the random instances; paired speed-ups with "
+            f"{level_name(summary['level'])} CIs.",
             "",
             informed_section(summary),
         ]
-    setup = ", ".join(f"{display_name(k)} {v:.2f} ms" for k, v in summary["setup_ms"].items())
-    parts += networks_section(networks or {})
+    setup = ", ".join(f"{label(k)} {v:.2f} ms" for k, v in summary["setup_ms"].items())
+    parts += networks_section(networks, metric_settings)
     parts += [
         "## Planning time and network inference",
         "",

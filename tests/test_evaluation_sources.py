@@ -7,17 +7,18 @@ import numpy as np
 import pytest
 from scipy import ndimage
 
-from vnrrt.evaluation.instances import EvalInstance
-from vnrrt.evaluation.oracle import (
-    KINDS,
+from vnrrt.data.instances import EvalInstance
+from vnrrt.evaluation.config import Configurations, OracleConfig, RegimeConfig
+from vnrrt.evaluation.keys import ConfigKey
+from vnrrt.evaluation.sampling_ideas.design import oracle_keys, regime_cells
+from vnrrt.evaluation.sources import (
+    ORACLE_KINDS,
     instance_heatmap,
     mass_near,
     mix,
     oracle_heatmap,
     target_mask,
 )
-from vnrrt.evaluation.protocol import PlannerSpec, parse_key
-from vnrrt.evaluation.study import OracleConfig, RegimeConfig, oracle_specs, regime_cells
 from vnrrt.evaluation.trials import run_trials
 from vnrrt.maps.config import DataConfig
 from vnrrt.maps.generate import generate_map, map_rng
@@ -59,7 +60,7 @@ def turning() -> EvalInstance:
     raise AssertionError("no instance with turns in 40 maps")
 
 
-@pytest.mark.parametrize("kind", KINDS)
+@pytest.mark.parametrize("kind", ORACLE_KINDS)
 def test_oracles_are_probability_maps_with_maximum_one(turning, kind):
     a = oracle_heatmap(kind, turning.grid, turning.start_cell, turning.goal_cell, sigma=1.0)
     b = oracle_heatmap(kind, turning.grid, turning.start_cell, turning.goal_cell, sigma=1.0)
@@ -112,8 +113,8 @@ def test_mixing_goes_from_the_oracle_to_uniform(turning):
 
 def test_the_study_has_every_idea_and_parses_its_keys():
     nets = {"nrrt_star": "nrrtnet", "vnrrt_star": "vertexnet", "m_vnrrt_star": "vertexnet"}
-    specs = oracle_specs(OracleConfig(qualities=[1.0, 0.1]), [0.5, 0.9], nets)
-    keys = [s.key for s in specs]
+    ev = Configurations(sources=nets, informed=True)
+    keys = [k.text for k in oracle_keys(OracleConfig(qualities=[1.0, 0.1]), ev, [0.5, 0.9])]
     assert len(keys) == len(set(keys))
     for key in (
         "rrt_star",
@@ -126,10 +127,21 @@ def test_the_study_has_every_idea_and_parses_its_keys():
         "nrrt_star[oracle_path@q0.1]",
     ):
         assert key in keys, key
-    assert parse_key("m_vnrrt_star@0.5[oracle_vertex]") == PlannerSpec(
-        "m_vnrrt_star", 0.5, "oracle_vertex", "m_vnrrt_star@0.5[oracle_vertex]"
+    assert "rrt_star+informed" in keys and "nrrt_star+informed" in keys
+    assert ConfigKey.parse("m_vnrrt_star@0.5[oracle_vertex]") == ConfigKey(
+        "m_vnrrt_star", 0.5, "oracle_vertex", named_source=True
     )
-    assert parse_key("vnrrt_star", {"vnrrt_star": "vertexnet"}).source == "vertexnet"
+    assert ConfigKey.parse("vnrrt_star", {"vnrrt_star": "vertexnet"}).source == "vertexnet"
+
+
+def test_the_oracle_study_runs_the_configured_planners_and_informed_flag():
+    """``eval.planners`` and ``eval.informed`` decide the study's network configurations
+    (no default stands in for them)."""
+    nets = {"nrrt_star": "nrrtnet", "vnrrt_star": "vertexnet", "m_vnrrt_star": "vertexnet"}
+    ev = Configurations(planners=["rrt_star", "vnrrt_star"], sources=nets, informed=False)
+    keys = [k.text for k in oracle_keys(OracleConfig(kinds=["oracle_path"], qualities=[1.0]),
+                                        ev, [0.5])]  # fmt: skip
+    assert keys == ["rrt_star", "vnrrt_star", "nrrt_star[oracle_path]"]
 
 
 def test_a_sweep_cell_changes_the_setting_it_names(turning):
@@ -168,8 +180,8 @@ def test_a_sweep_cell_changes_the_setting_it_names(turning):
 def test_a_perfect_path_heatmap_makes_nrrt_reach_the_optimum_in_far_fewer_iterations():
     """Fails if the oracle or its plumbing (source -> heatmap -> sampler) is wrong."""
     instances = [make_instance(m, k) for m in range(3) for k in range(2)]
-    specs = [PlannerSpec("rrt_star"), PlannerSpec("nrrt_star", None, "oracle_path")]
-    table = run_trials(instances, specs, {("random", "optimal"): 3}, workers=1)
+    keys = [ConfigKey("rrt_star"), ConfigKey("nrrt_star", None, "oracle_path")]
+    table = run_trials(instances, keys, {("random", "optimal"): 3}, workers=1)
     assert table["success"].all()
     med = table.groupby("key")["iterations"].median()
     assert med["nrrt_star"] < 0.5 * med["rrt_star"], med.to_dict()

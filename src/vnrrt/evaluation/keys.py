@@ -1,0 +1,146 @@
+"""The configuration key: the planner, mask threshold, heatmap source and sampling mode that a
+row of a trial table belongs to, as one typed value with one way to write it
+(:attr:`ConfigKey.text`) and one way to read it (:meth:`ConfigKey.parse`). Trials, tables,
+statistics, reports, figures and MLflow runs all go through it.
+
+Text form (the ``key`` column of the trial tables)::
+
+    planner[@tau][[source]][+informed]
+
+* ``rrt_star``, ``vnrrt_star``, ``m_vnrrt_star@0.5``: a configuration of the protocol; a
+  learned planner samples the source the configuration assigns it (``eval.sources``), which
+  the text leaves out;
+* ``vnrrt_star[oracle_vertex]``, ``nrrt_star[oracle_path@q0.1]``: the source is named (an
+  oracle, :mod:`vnrrt.evaluation.sources`, or another network);
+* ``+informed``: the same configuration with informed sampling (Gammell et al. 2014).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
+
+from vnrrt.config import ConfigError
+from vnrrt.names import PLANNER_NAMES, PLANNERS
+
+INFORMED = "+informed"  # text suffix of a configuration with informed sampling
+SHORT = {"rrt_star": "rrt", "nrrt_star": "nrrt", "vnrrt_star": "vnrrt", "m_vnrrt_star": "m"}
+
+
+@dataclass(frozen=True)
+class ConfigKey:
+    """One evaluated configuration.
+
+    ``tau`` is M-VNRRT*'s mask threshold (only M-VNRRT* has one); ``source`` the heatmap a
+    learned planner samples (a network name or an oracle source; None for RRT*, or for a
+    protocol configuration not yet resolved against ``eval.sources``); ``named_source``
+    whether the text names the source (else it is the protocol's).
+    """
+
+    planner: str
+    tau: float | None = None
+    source: str | None = None
+    informed: bool = False
+    named_source: bool = False
+
+    def __post_init__(self) -> None:
+        if self.planner not in PLANNERS:
+            raise ConfigError(f"unknown planner {self.planner!r}; known: {PLANNERS}")
+        if self.planner == "rrt_star" and self.source is not None:
+            raise ConfigError("rrt_star samples uniformly: it takes no heatmap source")
+        if (self.planner == "m_vnrrt_star") != (self.tau is not None):
+            raise ConfigError(f"{self.planner}: M-VNRRT* and only M-VNRRT* takes tau")
+        if self.tau is not None and not math.isfinite(self.tau):
+            raise ConfigError(f"{self.planner}: tau must be finite, got {self.tau!r}")
+        if self.named_source and self.source is None:
+            raise ConfigError(f"{self.planner}: a named source needs a source")
+
+    @property
+    def text(self) -> str:
+        """The key's one written form (module doc)."""
+        out = self.planner if self.tau is None else f"{self.planner}@{self.tau:g}"
+        if self.named_source:
+            out += f"[{self.source}]"
+        return out + (INFORMED if self.informed else "")
+
+    def __str__(self) -> str:
+        return self.text
+
+    @classmethod
+    def parse(cls, text: str, sources: Mapping[str, str] | None = None) -> ConfigKey:
+        """The key ``text`` writes; a learned planner without a named source samples its
+        source in ``sources`` (``eval.sources``; left unresolved when None).
+        :class:`ConfigError` naming ``text`` if it is not a key."""
+        body = text.removesuffix(INFORMED)
+        base, bracket, rest = body.partition("[")
+        if bracket and (not rest.endswith("]") or len(rest) < 2 or "[" in rest):
+            raise ConfigError(f"bad configuration {text!r}: expected planner[@tau][[source]]")
+        planner, at, tau = base.partition("@")
+        try:
+            value = float(tau) if at else None
+        except ValueError:
+            raise ConfigError(f"bad configuration {text!r}: tau {tau!r} is not a number") from None
+        named = rest[:-1] if bracket else None
+        source = named if named else (sources or {}).get(planner)
+        if planner == "rrt_star" and not named:
+            source = None
+        try:
+            return cls(planner, value, source, body != text, bool(named))
+        except ConfigError as err:
+            raise ConfigError(f"bad configuration {text!r}: {err}") from None
+
+    def with_source(self, source: str) -> ConfigKey:
+        """This configuration sampling ``source`` instead (named in the text)."""
+        return dataclasses.replace(self, source=source, named_source=True)
+
+    def with_informed(self, informed: bool = True) -> ConfigKey:
+        """This configuration with (or without) informed sampling."""
+        return dataclasses.replace(self, informed=informed)
+
+    @property
+    def label(self) -> str:
+        """The display name: ``M-VNRRT* τ=0.5``, ``VNRRT* [oracle_vertex]``,
+        ``Informed RRT*``, ``informed NRRT*``."""
+        name = PLANNER_NAMES[self.planner] + ("" if self.tau is None else f" τ={self.tau:g}")
+        name += f" [{self.source}]" if self.named_source else ""
+        if not self.informed:
+            return name
+        return "Informed RRT*" if name == "RRT*" else f"informed {name}"
+
+    @property
+    def short(self) -> str:
+        """A short name for metric keys: ``rrt``, ``m0.5``, ``nrrt+informed``."""
+        out = SHORT[self.planner] + ("" if self.tau is None else f"{self.tau:g}")
+        out += f"({self.source})" if self.named_source else ""
+        return out + (INFORMED if self.informed else "")
+
+    def rank(self) -> tuple:
+        """Sort order: not informed first, then the paper's planner order, tau, source."""
+        return (
+            self.informed,
+            PLANNERS.index(self.planner),
+            -1.0 if self.tau is None else self.tau,
+            self.source if self.named_source else "",
+        )
+
+
+def parse_keys(texts: Iterable[str], sources: Mapping[str, str] | None = None) -> list[ConfigKey]:
+    """:meth:`ConfigKey.parse` of each text."""
+    return [ConfigKey.parse(t, sources) for t in texts]
+
+
+def label(text: str) -> str:
+    """The display name of a key's text (:attr:`ConfigKey.label`)."""
+    return ConfigKey.parse(text).label
+
+
+def sort_texts(texts: Iterable[str]) -> list[str]:
+    """Key texts in the paper's order (:meth:`ConfigKey.rank`)."""
+    return sorted(texts, key=lambda t: ConfigKey.parse(t).rank())
+
+
+def is_informed(text: str) -> bool:
+    """Whether a key's text names an informed configuration."""
+    return ConfigKey.parse(text).informed

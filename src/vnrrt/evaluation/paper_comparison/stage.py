@@ -1,0 +1,155 @@
+"""Entry points of the paper comparison's stages.
+
+* ``evaluate``: the trial parts merged once (checked complete) into ``paths.trials_table``,
+  every statistic of the report (``paths.summary``, :func:`.summary.analyze`) and the
+  convergence curves (``paths.convergence``, ``paths.convergence_plots``);
+* ``report``: ``paths.report`` (:func:`.report.build_report`), Fig. 5 and the convergence
+  figure (``paths.evaluation_figures``), the headline metrics (``paths.headline``) and the
+  MLflow evaluation runs (:mod:`.runs`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+from pathlib import Path
+
+from omegaconf import DictConfig
+
+from vnrrt.config import section
+from vnrrt.paths import Paths
+
+log = logging.getLogger(__name__)
+
+
+def evaluate_settings(cfg: DictConfig) -> dict:
+    """What stage ``evaluate`` reads, typed (keyed by config section)."""
+    from vnrrt.evaluation.config import EvalConfig, Rules, StatsConfig
+
+    return {
+        "paths": section(cfg, "paths", Paths),
+        "eval": section(cfg, "eval", EvalConfig),
+        "stats": section(cfg, "stats", StatsConfig),
+        "planner": section(cfg, "planner", Rules),
+    }
+
+
+def run_evaluate(cfg: DictConfig) -> dict:
+    """Stage ``evaluate`` (module doc); returns the summary."""
+    from vnrrt.data.instances import Instances
+    from vnrrt.evaluation.paper_comparison.summary import analyze, convergence_curves
+    from vnrrt.evaluation.paper_tables import load_paper_tables
+    from vnrrt.evaluation.protocol import configurations, trial_counts, trial_jobs
+    from vnrrt.evaluation.table import merge_parts, write_table
+    from vnrrt.io import write_json, write_text
+
+    s = evaluate_settings(cfg)
+    paths, ev, st, rules = s["paths"], s["eval"], s["stats"], s["planner"]
+    keys = configurations(ev, rules.mask_taus)
+    jobs = trial_jobs(Instances(paths.instances).kinds, keys, trial_counts(ev))
+    table = merge_parts(paths.trials, ev.parts, sum(j.count for j in jobs))
+    write_table(table, paths.trials_table)
+    paper = load_paper_tables(paths.paper_tables)
+    eps = rules.eps
+    summary = analyze(table, paper, eps, st.bootstrap, st.level)
+    write_json(paths.summary, summary)
+    curves = convergence_curves(table, eps)
+    write_text(paths.convergence, curves.to_csv(index=False))
+    for map_set, frame in series_per_map_set(curves).items():
+        write_text(Path(paths.convergence_plots) / f"{map_set}.csv", frame.to_csv(index=False))
+    return summary
+
+
+def series_per_map_set(curves) -> dict:
+    """``dvc plots`` data: per map set, the stop rule ``optimal`` curves as columns planner
+    (display name), median_time_ms and cost_ratio (template ``.dvc/plots/series.json``)."""
+    from vnrrt.evaluation.keys import is_informed, label
+
+    opt = curves[(curves["stop"] == "optimal") & ~curves["planner"].map(is_informed)]
+    out = {}
+    for map_set, sub in opt.groupby("map_set", sort=False):
+        frame = sub.assign(
+            planner=[label(k) for k in sub["planner"]],
+            median_time_ms=1e3 * sub["median_time"],
+            cost_ratio=sub["factor"],
+        )
+        out[map_set] = frame[["planner", "median_time_ms", "cost_ratio"]]
+    return out
+
+
+def report_settings(cfg: DictConfig) -> dict:
+    """What stage ``report`` reads, typed (keyed by config section)."""
+    from vnrrt.evaluation.config import EvalConfig, Rules
+    from vnrrt.tracking import LoggerConfig
+
+    return {
+        "paths": section(cfg, "paths", Paths),
+        "eval": section(cfg, "eval", EvalConfig),
+        "planner": section(cfg, "planner", Rules),
+        "logger": section(cfg, "logger", LoggerConfig),
+        "scale": {"name": str(cfg.scale.name)},
+    }
+
+
+def run_report(cfg: DictConfig) -> Path:
+    """Stage ``report`` (module doc); returns the report's path."""
+    from vnrrt.data.instances import Instances
+    from vnrrt.evaluation.paper_comparison.report import build_report, headline, metric_settings
+    from vnrrt.evaluation.paper_tables import load_paper_tables
+    from vnrrt.evaluation.protocol import configurations
+    from vnrrt.io import read_json, write_json, write_text
+
+    s = report_settings(cfg)
+    paths, ev, rules, logger, scale = s["paths"], s["eval"], s["planner"], s["logger"], s["scale"]
+    keys = configurations(ev, rules.mask_taus)
+    summary, predict = read_json(paths.summary), read_json(paths.predict_metrics)
+    networks = predict["networks"]
+    text = build_report(
+        summary,
+        load_paper_tables(paths.paper_tables),
+        Instances(paths.instances).optima(),
+        {n: float(m["ms_per_map"]) for n, m in networks.items()},
+        {k.text: k.source for k in keys if k.source},
+        scale["name"],
+        networks,
+        metric_settings(predict["settings"]),
+    )
+    write_text(paths.report, text)
+    figures = save_figures(paths, summary)
+    metrics = headline(summary, networks)
+    write_json(paths.headline, metrics)
+    if logger.enabled:
+        from vnrrt.evaluation.paper_comparison.runs import log_evaluation
+
+        artifacts = [Path(paths.report), *figures, Path(paths.trials_table)]
+        trainings = {n: paths.train_metrics(n) for n in sorted(set(ev.sources.values()))}
+        params = {"eval": dataclasses.asdict(ev), "planner": dataclasses.asdict(rules)}
+        log_evaluation(
+            logger, scale["name"], params, ev.sources, summary, metrics, artifacts, trainings
+        )
+    return Path(paths.report)
+
+
+def save_figures(paths: Paths, summary: dict) -> list[Path]:
+    """Fig. 5 (paired improvement over RRT*) per stop rule that was run, and the
+    convergence figure, under ``paths.evaluation_figures``; returns the files written."""
+    import pandas as pd
+
+    from vnrrt.data.instances import Instances
+    from vnrrt.viz.evaluation import save_convergence, save_improvements
+
+    figs = Path(paths.evaluation_figures)
+    written = []
+    eps, level = summary["eps"], summary["level"]
+    for stop in summary["stops"]:
+        if stop in summary["over_rrt_star"]["time_to_stop"]:
+            path = figs / f"improvement_{stop}.png"
+            save_improvements(
+                path, summary["over_rrt_star"]["time_to_stop"][stop], stop, eps, level
+            )
+            written.append(path)
+    curves = pd.read_csv(paths.convergence)
+    if len(curves):
+        save_convergence(figs / "convergence.png", curves, Instances(paths.instances).named())
+        written.append(figs / "convergence.png")
+    return written

@@ -1,0 +1,205 @@
+"""Entry points of the sampling-ideas study's stages
+(:mod:`vnrrt.evaluation.sampling_ideas.design` says what runs).
+
+* ``oracle@<k>``: part ``k`` of the oracle study -> ``paths.oracle_part(k)``;
+* ``regime@<k>``: part ``k`` of the planner-regime sweep -> ``paths.regime_part(k)``;
+* ``ideas``: both merged (checked complete), their statistics (``paths.ideas_summary``),
+  ``paths.ideas_report`` and its figures (``paths.ideas_figures``), and the MLflow run.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+from omegaconf import DictConfig
+
+from vnrrt.config import ConfigError, section
+from vnrrt.evaluation.config import Configurations, OracleConfig, RegimeConfig, mask_taus
+from vnrrt.paths import Paths
+
+log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class Study:
+    """The typed sections the study's stages read: ``eval``'s configurations, ``oracle``,
+    ``regime`` and the M-VNRRT* thresholds ``taus`` (``planner.taus`` and ``planner.tau``)."""
+
+    paths: Paths
+    sources: dict[str, str]  # eval.sources
+    configurations: Configurations | None  # eval's; None where only the sweep runs
+    oracle: OracleConfig
+    regime: RegimeConfig | None  # None where only the oracle study runs
+    taus: list[float]
+
+    def design(self, which: str) -> tuple[list, dict, dict, list[int], int]:
+        """``(keys, counts, cells, parts, instances)`` of the oracle study (``which=
+        'oracle'``) or of the regime sweep; ``cells``: label -> planner overrides."""
+        from vnrrt.evaluation.sampling_ideas import design as d
+
+        if which == "oracle":
+            o = self.oracle
+            keys = d.oracle_keys(o, self.configurations, self.taus)
+            return keys, d.oracle_counts(o), {"": {}}, o.parts, o.random_maps
+        r = self.regime
+        keys = d.regime_keys(r, self.sources)
+        return keys, d.regime_counts(), d.regime_cells(r), r.parts, r.random_maps
+
+    def jobs(self, which: str) -> list:
+        """Every job of the oracle study or the regime sweep, in canonical order."""
+        from vnrrt.data.instances import Instances
+        from vnrrt.evaluation.protocol import trial_jobs
+
+        keys, counts, cells, _, n = self.design(which)
+        kinds = Instances(self.paths.instances).kinds
+        chosen = [i for i, k in enumerate(kinds) if k == "random"][:n]
+        return trial_jobs(kinds, keys, counts, regimes=tuple(cells), instances=chosen)
+
+
+def part_settings(cfg: DictConfig, which: str) -> dict:
+    """What stage ``oracle@<k>`` (``which='oracle'``) or ``regime@<k>`` reads, typed (keyed
+    by config section): the oracle study reads ``eval``'s configurations, the sweep
+    ``eval.sources``; both the ``oracle`` section (the oracles' blur, floor and mass radius)
+    and the whole ``planner``."""
+    from vnrrt.config import check_parts
+    from vnrrt.planners.config import PlannerConfig
+
+    oracle_study = which == "oracle"
+    return {
+        "paths": section(cfg, "paths", Paths),
+        "eval": section(cfg, "eval", Configurations)
+        if oracle_study
+        else {"sources": dict(cfg.eval.sources)},
+        "oracle": section(cfg, "oracle", OracleConfig),
+        "regime": None if oracle_study else section(cfg, "regime", RegimeConfig),
+        "planner": section(cfg, "planner", PlannerConfig),
+        "predict": {"parts": check_parts(cfg.predict.parts, "predict.parts")},
+        "seed": int(cfg.seed),
+        "workers": int(cfg.workers),
+    }
+
+
+def ideas_settings(cfg: DictConfig) -> dict:
+    """What stage ``ideas`` reads, typed (keyed by config section)."""
+    from vnrrt.evaluation.config import Rules, StatsConfig
+    from vnrrt.tracking import LoggerConfig
+
+    return {
+        "paths": section(cfg, "paths", Paths),
+        "eval": section(cfg, "eval", Configurations),
+        "oracle": section(cfg, "oracle", OracleConfig),
+        "regime": section(cfg, "regime", RegimeConfig),
+        "planner": section(cfg, "planner", Rules),
+        "stats": section(cfg, "stats", StatsConfig),
+        "logger": section(cfg, "logger", LoggerConfig),
+        "scale": {"name": str(cfg.scale.name)},
+    }
+
+
+def _study(s: dict) -> Study:
+    """The :class:`Study` of a stage's settings (:func:`part_settings`,
+    :func:`ideas_settings`)."""
+    ev, planner = s["eval"], s["planner"]
+    configurations = ev if isinstance(ev, Configurations) else None
+    sources = ev.sources if configurations else ev["sources"]
+    taus = mask_taus(planner.taus, planner.tau)
+    return Study(s["paths"], dict(sources), configurations, s["oracle"], s["regime"], taus)
+
+
+def _run_part(cfg: DictConfig, part: int, which: str) -> int:
+    """Part ``part`` of the oracle study or the regime sweep; returns the number of trials."""
+    from vnrrt.data.instances import load
+    from vnrrt.evaluation.protocol import part_jobs
+    from vnrrt.evaluation.sources import is_oracle
+    from vnrrt.evaluation.table import write_table
+    from vnrrt.evaluation.trials import HeatSettings, run_jobs
+
+    settings = part_settings(cfg, which)
+    s, planner = _study(settings), settings["planner"]
+    _, _, cells, parts, _ = s.design(which)
+    if part not in parts:
+        raise ConfigError(f"part {part} is not in {which}.parts {parts}")
+    jobs = part_jobs(s.jobs(which), part, len(parts))
+    networks = sorted({j.key.source for j in jobs if j.key.source and not is_oracle(j.key.source)})
+    indices = sorted({job.instance for job in jobs})
+    predict_parts = settings["predict"]["parts"]
+    instances, targets = load(s.paths.instances, indices, networks, s.paths.heatmaps, predict_parts)
+    heat = HeatSettings(s.oracle.radius, targets, s.oracle.sigma, s.oracle.floor)
+    configs = {label: planner.replace(**over) for label, over in cells.items()}
+    log.info(
+        "%s part %d/%d: %d jobs on %d instances", which, part, len(parts), len(jobs), len(instances)
+    )
+    table = run_jobs(jobs, instances, settings["seed"], settings["workers"], configs, heat)
+    out = s.paths.oracle_part(part) if which == "oracle" else s.paths.regime_part(part)
+    write_table(table, out)
+    return len(table)
+
+
+def run_oracle_part(cfg: DictConfig, part: int) -> int:
+    """Stage ``oracle@<part>`` (module doc)."""
+    return _run_part(cfg, part, "oracle")
+
+
+def run_regime_part(cfg: DictConfig, part: int) -> int:
+    """Stage ``regime@<part>`` (module doc)."""
+    return _run_part(cfg, part, "regime")
+
+
+def run_ideas(cfg: DictConfig) -> dict:
+    """Stage ``ideas`` (module doc); returns the summary."""
+    import os
+
+    from vnrrt.evaluation.paper_tables import claim_pairs, load_paper_tables
+    from vnrrt.evaluation.protocol import configurations
+    from vnrrt.evaluation.sampling_ideas.report import build_ideas_report
+    from vnrrt.evaluation.sampling_ideas.summary import analyze_study
+    from vnrrt.evaluation.table import merge_parts
+    from vnrrt.io import write_json, write_text
+
+    settings = ideas_settings(cfg)
+    rules, st, logger = settings["planner"], settings["stats"], settings["logger"]
+    s, scale = _study(settings), settings["scale"]["name"]
+    tables = {}
+    for which in ("oracle", "regime"):
+        folder = s.paths.oracle if which == "oracle" else s.paths.regime
+        rows = sum(j.count for j in s.jobs(which))
+        tables[which] = merge_parts(folder, s.design(which)[3], rows)
+    networks = [k.text for k in configurations(s.configurations, s.taus) if k.source]
+    pairs = claim_pairs(load_paper_tables(s.paths.paper_tables))
+    shown = {"eps": rules.eps, "level": st.level, "bootstrap": st.bootstrap}
+    shown |= {"radius": s.oracle.radius, "sigma": s.oracle.sigma, "floor": s.oracle.floor}
+    summary = analyze_study(tables["oracle"], tables["regime"], networks, pairs, shown)
+    write_json(s.paths.ideas_summary, summary)
+    written = save_figures(s.paths, summary)
+    report = Path(s.paths.ideas_report)
+    relative = [os.path.relpath(f, report.parent) for f in written]
+    write_text(report, build_ideas_report(summary, scale, relative))
+    if logger.enabled:
+        from vnrrt.evaluation.sampling_ideas.runs import log_ideas
+
+        params = {"oracle": asdict(s.oracle), "regime": asdict(s.regime)}
+        artifacts = [report, Path(s.paths.ideas_summary), *written]
+        log_ideas(logger, scale, params, summary, artifacts)
+    return summary
+
+
+def save_figures(paths: Paths, summary: dict) -> list[Path]:
+    """The quality curve and the regime figures under ``paths.ideas_figures``; returns the
+    files written."""
+    import pandas as pd
+
+    from vnrrt.viz.ideas import save_quality, save_regime
+
+    figs, written = Path(paths.ideas_figures), []
+    curves, nets = pd.DataFrame(summary["curves"]), pd.DataFrame(summary["networks"])
+    if not curves.empty:
+        save_quality(figs / "quality_curve.png", curves, nets, summary["settings"])
+        written.append(figs / "quality_curve.png")
+    sweep = pd.DataFrame(summary["regime"])
+    for stop in ("optimal", "optimal_any_angle"):
+        if not sweep.empty and stop in set(sweep["stop"]):
+            save_regime(figs / f"regime_{stop}.png", sweep, stop, summary["settings"])
+            written.append(figs / f"regime_{stop}.png")
+    return written

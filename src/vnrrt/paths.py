@@ -1,0 +1,141 @@
+"""Every file the pipeline writes or reads, once: the typed ``paths`` section
+(``conf/paths/default.yaml``) and the single table of each stage's outputs
+(:func:`stage_outputs`).
+
+Stages get their file names from a :class:`Paths` (never by composing names of their own);
+``dvc.yaml`` writes the same names again, as DVC needs them, and
+``tests/test_stage_outputs.py`` checks that both agree and that each stage writes exactly its
+outputs. Files of a part ``k``, a shard or a network are named here too (the format modules
+re-export :func:`shard_file`, :func:`heatmaps_part_file` and :func:`table_part_file`). A leaf
+module: it imports nothing of vnrrt but the config errors.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from pathlib import Path
+
+from vnrrt.config import ConfigError
+
+
+@dataclass(frozen=True)
+class Paths:
+    """The ``paths`` section: folders and files relative to the repository root."""
+
+    data: str
+    validated: str
+    shards: str
+    manifest: str
+    named_maps: str
+    instances: str
+    heatmaps: str
+    timing: str
+    trials: str
+    trials_table: str
+    summary: str
+    oracle: str
+    regime: str
+    ideas_summary: str
+    models: str
+    figures: str
+    metrics: str
+    plots: str
+    report: str
+    ideas_report: str
+    paper_tables: str
+    named_maps_figure: str
+    heatmaps_figure: str
+    data_metrics: str
+    predict_metrics: str
+    headline: str
+    convergence: str
+    convergence_plots: str
+    evaluation_figures: str
+    ideas_figures: str
+
+    def validate(self) -> None:
+        """Raise :class:`ConfigError` for an empty path."""
+        for f in dataclasses.fields(self):
+            if not str(getattr(self, f.name)).strip():
+                raise ConfigError(f"invalid config value paths.{f.name}: an empty path")
+
+    def shard(self, shard_id: int) -> Path:
+        """Shard ``shard_id`` (stage ``shard@<id>``)."""
+        return shard_file(self.shards, shard_id)
+
+    def checkpoint(self, network: str) -> Path:
+        """The trained network's checkpoint (stage ``train@<network>``)."""
+        return Path(self.models) / f"{network}.ckpt"
+
+    def checksum(self, network: str) -> Path:
+        """The sidecar sha256 of :meth:`checkpoint`."""
+        return Path(self.models) / f"{network}.ckpt.sha256"
+
+    def train_metrics(self, network: str) -> Path:
+        """The training metrics of ``network`` (stage ``train@<network>``)."""
+        return Path(self.metrics) / f"train_{network}.json"
+
+    def run_folder(self, network: str) -> Path:
+        """Lightning's last-epoch checkpoints of a training in progress (removed after)."""
+        return Path(self.models) / "checkpoints" / network
+
+    def heatmaps_part(self, part: int) -> Path:
+        """Heatmaps of prediction part ``part`` (stage ``predict@<part>``)."""
+        return heatmaps_part_file(self.heatmaps, part)
+
+    def timing_part(self, part: int) -> Path:
+        """Inference times of prediction part ``part`` (stage ``predict@<part>``)."""
+        return Path(self.timing) / f"predict_{part}.json"
+
+    def trials_part(self, part: int) -> Path:
+        """Trial table of part ``part`` (stage ``trials@<part>``)."""
+        return table_part_file(self.trials, part)
+
+    def oracle_part(self, part: int) -> Path:
+        """Trial table of oracle-study part ``part`` (stage ``oracle@<part>``)."""
+        return table_part_file(self.oracle, part)
+
+    def regime_part(self, part: int) -> Path:
+        """Trial table of regime-sweep part ``part`` (stage ``regime@<part>``)."""
+        return table_part_file(self.regime, part)
+
+
+def shard_file(shards_dir: str | Path, shard_id: int) -> Path:
+    """Shard ``shard_id`` in ``shards_dir``: ``shard_<id>.npz``."""
+    return Path(shards_dir) / f"shard_{shard_id}.npz"
+
+
+def heatmaps_part_file(directory: str | Path, part: int) -> Path:
+    """The heatmaps of prediction part ``part`` in ``directory``: ``part_<part>.npz``."""
+    return Path(directory) / f"part_{part}.npz"
+
+
+def table_part_file(directory: str | Path, part: int) -> Path:
+    """The trial table of part ``part`` in ``directory``: ``part_<part>.csv``."""
+    return Path(directory) / f"part_{part}.csv"
+
+
+def stage_outputs(stage: str, paths: Paths, item=None) -> list[Path]:
+    """The files (and output folders) stage ``stage`` (``item``: its part, shard id or
+    network) writes, as ``dvc.yaml`` declares them."""
+    p = paths
+    table = {
+        "validate": lambda: [p.validated],
+        "shard": lambda: [p.shard(int(item))],
+        "named_maps": lambda: [p.named_maps, p.named_maps_figure],
+        "manifest": lambda: [p.manifest, p.data_metrics],
+        "instances": lambda: [p.instances],
+        "train": lambda: [p.checkpoint(item), p.checksum(item), p.train_metrics(item)],
+        "predict": lambda: [p.heatmaps_part(int(item)), p.timing_part(int(item))],
+        "predict_metrics": lambda: [p.predict_metrics, p.heatmaps_figure],
+        "trials": lambda: [p.trials_part(int(item))],
+        "oracle": lambda: [p.oracle_part(int(item))],
+        "regime": lambda: [p.regime_part(int(item))],
+        "ideas": lambda: [p.ideas_summary, p.ideas_report, p.ideas_figures],
+        "evaluate": lambda: [p.trials_table, p.summary, p.convergence, p.convergence_plots],
+        "report": lambda: [p.report, p.headline, p.evaluation_figures],
+    }
+    if stage not in table:
+        raise ConfigError(f"no outputs known for stage {stage!r}; known: {sorted(table)}")
+    return [Path(f) for f in table[stage]()]
