@@ -39,10 +39,11 @@ from vnrrt.data.config import LabelsConfig
 from vnrrt.data.datamodule import InstanceDataset
 from vnrrt.data.shards import shard_file
 from vnrrt.evaluation.config import EvalConfig
-from vnrrt.evaluation.protocol import planner_specs, trial_counts
+from vnrrt.evaluation.protocol import configurations, trial_counts
 from vnrrt.evaluation.table import read_table
 from vnrrt.maps.config import DataConfig
 from vnrrt.model import VertexNet
+from vnrrt.names import mask_taus
 from vnrrt.parallel import n_workers
 from vnrrt.planners import PlannerConfig, plan, warmup
 from vnrrt.planners.reference import any_angle_length
@@ -122,16 +123,16 @@ def trials_hours(per_trial: pd.Series, ratio: float, cfg) -> tuple[float, int, l
     planner configurations whose rate was borrowed."""
     ev = section(cfg, "eval", EvalConfig)
     planner = section(cfg, "planner", PlannerConfig)
-    specs = planner_specs(ev, [*planner.taus, planner.tau])
+    specs = configurations(ev, mask_taus(planner.taus, planner.tau))
     n_inst = {"named": 5, "random": ev.random_maps}
     seconds, count, borrowed = 0.0, 0, set()
     for (kind, stop), per_instance in trial_counts(ev).items():
         for spec in specs:
-            key, factor = (kind, stop, spec.key), 1.0
+            key, factor = (kind, stop, spec.text), 1.0
             if key not in per_trial.index and stop == "optimal_any_angle":
-                key, factor = (kind, "optimal", spec.key), ratio
+                key, factor = (kind, "optimal", spec.text), ratio
             if key not in per_trial.index:  # e.g. a tau not in the table: RRT*'s rate
-                borrowed.add(spec.key)
+                borrowed.add(spec.text)
                 key = (kind, key[1], "rrt_star")
             n = per_instance * n_inst[kind]
             seconds += n * factor * float(per_trial[key])

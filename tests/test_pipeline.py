@@ -1,7 +1,12 @@
 """The DVC pipeline end to end at smoke scale, in a scratch git + DVC copy of the repository:
 validation before any work, verified deterministic shards, resuming, temp files DVC does not
-hash, the whole run with its report, metrics, plots and MLflow runs, reproducible outputs, an
-evaluation-only experiment that re-runs only the evaluation, and the parts as multirun jobs."""
+hash, the whole run with its report, metrics, plots and MLflow runs, each stage writing
+exactly its outputs, reproducible outputs, an ablation experiment that re-runs only the
+evaluation and whose every report, figure and metrics file names the values it ran, and (slow)
+the parts as multirun jobs.
+
+Every stage script runs with ``tests/write_audit`` on ``PYTHONPATH``: it logs the files each
+stage process created or changed (``writes.jsonl`` beside the work folder)."""
 
 import json
 import os
@@ -16,7 +21,7 @@ import pytest
 import yaml
 
 from tests.conftest import copy_dvc_files, copy_pipeline
-from vnrrt.config import compose, dump
+from vnrrt.config import compose, dump, section
 from vnrrt.data.build import build_shard
 from vnrrt.data.config import LabelsConfig
 from vnrrt.data.heatmaps import read_heatmaps
@@ -24,13 +29,22 @@ from vnrrt.data.manifest import verify_manifest
 from vnrrt.data.shards import shard_file
 from vnrrt.evaluation.table import SEEDED_COLUMNS, merge_parts
 from vnrrt.maps.config import DataConfig
+from vnrrt.paths import Paths, stage_outputs
 
 SHARDS = Path("data/smoke/shards")
+AUDIT = Path(__file__).resolve().parent / "write_audit"
+
+
+def write_log(work: Path) -> Path:
+    """The write audit's log of the work folder ``work`` (module doc)."""
+    return work.parent / "writes.jsonl"
 
 
 def run(cmd: list[str], cwd: Path, ok: bool = True, **env_vars: str) -> str:
     env = dict(os.environ, PATH=f"{Path(sys.executable).parent}{os.pathsep}{os.environ['PATH']}")
     env.pop("MLFLOW_TRACKING_URI", None)
+    env["PYTHONPATH"] = os.pathsep.join(p for p in (str(AUDIT), env.get("PYTHONPATH")) if p)
+    env["VNRRT_WRITE_LOG"] = str(write_log(cwd))
     env.update(env_vars)
     proc = subprocess.run(cmd, cwd=cwd, env=env, capture_output=True, text=True, check=False)
     if ok:
@@ -42,7 +56,7 @@ def run(cmd: list[str], cwd: Path, ok: bool = True, **env_vars: str) -> str:
 
 @pytest.fixture(scope="module")
 def workdir(tmp_path_factory, repo):
-    work = copy_pipeline(repo, tmp_path_factory.mktemp("pipeline"))
+    work = copy_pipeline(repo, tmp_path_factory.mktemp("pipeline") / "repo")
     run(["git", "init", "-q"], work)
     run(["dvc", "init", "-q"], work)
     copy_dvc_files(repo, work)
@@ -117,7 +131,7 @@ def test_smoke_dvc_repro_end_to_end(workdir):
         "exact continuous optimum",
         "## Planning time and network inference",
         "Bonferroni",
-        "## Time to within (1 + eps) of the exact continuous optimum",
+        "## Time to within 1% of the exact continuous optimum",
     ):
         assert text in report, text
     ideas = (workdir / "reports/sampling_ideas.md").read_text()
@@ -167,6 +181,37 @@ def test_metrics_and_plots_read_well(workdir):
     assert png[:4] == b"\x89PNG" and len(png) > 5000
 
 
+NOT_OUTPUTS = ("mlflow.db", "mlartifacts/")  # the MLflow store: runs, not pipeline outputs
+
+
+def _stage_of(argv: list[str]) -> tuple[str, str | None]:
+    """``(stage, item)`` of a stage script's command line: ``stages/trials.py --part 1``."""
+    name = Path(argv[0]).stem
+    return name, (argv[2] if len(argv) > 2 and argv[1].startswith("--") else None)
+
+
+def test_every_stage_writes_exactly_its_outputs(workdir, repo):
+    """Each stage process (recorded by the write audit) creates or changes exactly the files
+    of its outputs in ``dvc.yaml`` (:func:`vnrrt.paths.stage_outputs`, files under an output
+    folder included), besides the MLflow store; and ``dvc.yaml`` declares the same outputs."""
+    cfg = yaml.safe_load((workdir / "params.yaml").read_text())
+    paths = section(cfg, "paths", Paths)
+    entries = [json.loads(line) for line in write_log(workdir).read_text().splitlines()]
+    seen = set()
+    for entry in entries:
+        stage, item = _stage_of(entry["argv"])
+        seen.add(stage)
+        outs = [str(p) for p in stage_outputs(stage, paths, item)]
+        for path in entry["written"]:
+            if path.startswith(NOT_OUTPUTS):
+                continue
+            assert any(path == o or path.startswith(o + "/") for o in outs), (stage, item, path)
+        for out in outs:  # every declared output exists (an unchanged one is not rewritten)
+            assert (workdir / out).exists(), (stage, out)
+    stages = yaml.safe_load((repo / "dvc.yaml").read_text())["stages"]
+    assert seen == set(stages)
+
+
 def test_a_second_run_changes_only_timings(workdir):
     """Re-running prediction and trials on the same inputs gives byte-identical heatmaps
     and equal trial tables in every column but the timings; DVC sees nothing changed."""
@@ -185,11 +230,30 @@ def test_a_second_run_changes_only_timings(workdir):
     assert "predict@0" not in run(["dvc", "status"], workdir)
 
 
-def test_an_evaluation_only_experiment_reruns_only_the_evaluation(workdir):
+ABLATION = {  # every reader-visible setting changed at once (together: one experiment)
+    "planner.eps": 0.05,
+    "planner.taus": "[0.3,0.7]",
+    "planner.tau": 0.6,
+    "stats.level": 0.9,
+    "eval.informed": "false",
+}
+DEFAULT_TEXTS = ("within 1%", "1% of", "95%", "eps 0.01", "eps = 0.01", "τ=0.5", "τ=0.99")
+
+
+def _png_text(path: Path) -> str:
+    from PIL import Image
+
+    with Image.open(path) as img:
+        return img.text.get("Description", "")
+
+
+def test_an_ablation_reruns_only_the_evaluation_and_every_output_names_its_values(workdir):
     """After files of another scale appeared beside this one's (and a stray temp file),
-    `dvc exp run -S planner.tau=0.7` (at this workspace's smoke scale and seed: DVC composes
-    conf/ with the -S overrides) re-runs validation (cheap, constant output) and the
-    evaluation stages, nothing else."""
+    `dvc exp run -S ...` (at this workspace's smoke scale and seed: DVC composes conf/ with
+    the -S overrides) changing the stop tolerance, the tau list, the CI level and the
+    informed flag re-runs validation (cheap, constant output), the heatmap metrics (their
+    tau masks) and the evaluation stages, nothing else; and every report, figure and metrics
+    file names the values that ran, none of the defaults."""
     run(["dvc", "repro"], workdir)  # up to date first (the test before re-ran a prediction)
     run(["git", "add", "-A"], workdir)
     run(["git", "-c", "user.name=t", "-c", "user.email=t@t", "commit", "-qm", "smoke"], workdir)
@@ -197,16 +261,48 @@ def test_an_evaluation_only_experiment_reruns_only_the_evaluation(workdir):
     other.mkdir(parents=True)
     (other / "shard_7.npz").write_bytes(b"another scale's shard")
     (workdir / SHARDS / "shard_1.npz.tmp-999999").write_bytes(b"stray")
-    out = run(
-        ["dvc", "exp", "run", "-S", "scale=smoke", "-S", "seed=1", "-S", "planner.tau=0.7"], workdir
-    )
+    sets = [x for k, v in ABLATION.items() for x in ("-S", f"{k}={v}")]
+    out = run(["dvc", "exp", "run", "-S", "scale=smoke", "-S", "seed=1", *sets], workdir)
     ran = sorted(line.split("'")[1] for line in out.splitlines() if "Running stage" in line)
-    evaluation = ["evaluate", "ideas", "oracle@0", "regime@0", "report", "trials@0", "trials@1"]
-    assert ran == [*evaluation, "validate"], out
+    evaluation = ["evaluate", "ideas", "oracle@0", "predict_metrics", "regime@0", "report"]
+    assert ran == [*evaluation, "trials@0", "trials@1", "validate"], out
     table = pd.read_csv(workdir / "data/smoke/trials.csv")
-    assert "m_vnrrt_star@0.7" in set(table["key"])
+    taus = sorted(set(table["tau"].dropna()))
+    assert taus == [0.3, 0.6, 0.7] and not table["key"].str.endswith("+informed").any()
+    reports = {p: (workdir / p).read_text() for p in PAPER_REPORTS}
+    for name, text in reports.items():
+        text = "\n".join(ln for ln in text.splitlines() if "| paper |" not in ln)
+        for default in DEFAULT_TEXTS:
+            assert default not in text, (name, default)
+        assert "5%" in text and "90%" in text, name
+    paper = reports["reports/paper_comparison.md"]
+    assert "eps = 0.05" in paper and "## Informed sampling" not in paper
+    ours = {ln.split("|")[1].strip() for ln in paper.splitlines() if "| ours |" in ln}
+    masked = {n for n in ours if n.startswith("M-VNRRT*")}
+    assert masked == {"M-VNRRT* τ=0.3", "M-VNRRT* τ=0.6", "M-VNRRT* τ=0.7"}
+    figures = sorted((workdir / "reports/figures").rglob("*.png"))
+    said = {f.name: _png_text(f) for f in figures if "evaluation" in f.parts or "ideas" in f.parts}
+    assert len(said) >= 5
+    for name, text in said.items():
+        assert not any(d in text for d in DEFAULT_TEXTS), (name, text)
+    assert "within 5% of A*" in said["improvement_optimal.png"]
+    assert "90% CI" in said["improvement_optimal.png"] and "90% CI" in said["quality_curve.png"]
+    summary = json.loads((workdir / "data/smoke/summary.json").read_text())
+    assert (summary["eps"], summary["level"]) == (0.05, 0.9)
+    ideas = json.loads((workdir / "data/smoke/ideas.json").read_text())["settings"]
+    assert (ideas["eps"], ideas["level"]) == (0.05, 0.9)
+    predict = json.loads((workdir / "reports/metrics/predict.json").read_text())
+    assert predict["settings"]["taus"] == [0.3, 0.6, 0.7]
+    masses = {k for k in predict["networks"]["vertexnet"] if "interior_tau" in k}
+    assert {k.split("tau")[-1] for k in masses} == {"0_3", "0_6", "0_7"}
+    headline = json.loads((workdir / "reports/metrics/headline.json").read_text())
+    assert set(headline["opt_ms"]) == {"rrt", "nrrt", "vnrrt", "m0.3", "m0.6", "m0.7"}
 
 
+PAPER_REPORTS = ("reports/paper_comparison.md", "reports/sampling_ideas.md")
+
+
+@pytest.mark.slow
 def test_predict_and_trial_parts_as_multirun_jobs_write_the_stage_files(workdir, request):
     """The predict@<k> and trials@<k> parts again, as Hydra multirun shard jobs (joblib;
     trials on the local SLURM cluster where it runs). They write the stages' files: heatmaps

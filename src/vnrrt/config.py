@@ -80,6 +80,12 @@ def section(cfg: DictConfig | dict, key: str, schema: type[T]) -> T:
     return obj
 
 
+def sections(cfg: DictConfig | dict, **schemas: type) -> dict[str, Any]:
+    """``{name: section(cfg, name, schema)}`` for every ``name=schema``: a stage's typed
+    sections in one call."""
+    return {name: section(cfg, name, schema) for name, schema in schemas.items()}
+
+
 def load_params(path: str | Path = "params.yaml") -> DictConfig:
     """Load the composed parameters file (``params.yaml``) written by DVC or ``make params``."""
     path = Path(path)

@@ -126,11 +126,6 @@ class ConfigKey:
         )
 
 
-def parse_keys(texts: Iterable[str], sources: Mapping[str, str] | None = None) -> list[ConfigKey]:
-    """:meth:`ConfigKey.parse` of each text."""
-    return [ConfigKey.parse(t, sources) for t in texts]
-
-
 def label(text: str) -> str:
     """The display name of a key's text (:attr:`ConfigKey.label`)."""
     return ConfigKey.parse(text).label

@@ -17,7 +17,7 @@ import logging
 
 from omegaconf import DictConfig
 
-from vnrrt.config import ConfigError, check_parts, section
+from vnrrt.config import ConfigError, check_parts, section, sections
 from vnrrt.paths import Paths
 
 log = logging.getLogger(__name__)
@@ -51,10 +51,7 @@ def trials_settings(cfg: DictConfig) -> dict:
     from vnrrt.evaluation.config import EvalConfig
     from vnrrt.planners.config import PlannerConfig
 
-    return {
-        "paths": section(cfg, "paths", Paths),
-        "eval": section(cfg, "eval", EvalConfig),
-        "planner": section(cfg, "planner", PlannerConfig),
+    return sections(cfg, paths=Paths, eval=EvalConfig, planner=PlannerConfig) | {
         "oracle": {"radius": float(cfg.oracle.radius)},
         "predict": {"parts": check_parts(cfg.predict.parts, "predict.parts")},
         "seed": int(cfg.seed),

@@ -3,7 +3,7 @@
 
 Per job (one instance, one configuration, one stop rule, up to 25 trials) the heatmap is
 looked up (a trained network's, read from the prediction files) or built (an oracle,
-:mod:`vnrrt.evaluation.oracle`, from the instance's labels), the sampler is built from it
+:mod:`vnrrt.evaluation.sources`, from the instance's labels), the sampler is built from it
 once, outside the timed region, and every trial plans with it; the build time is recorded
 as ``setup_time`` and the heatmap's mass near its target as ``heat_mass``. Trial ``t`` of an
 instance gets the same seed in every configuration

@@ -16,7 +16,7 @@ from pathlib import Path
 
 from omegaconf import DictConfig
 
-from vnrrt.config import section
+from vnrrt.config import sections
 from vnrrt.paths import Paths
 
 log = logging.getLogger(__name__)
@@ -26,12 +26,7 @@ def evaluate_settings(cfg: DictConfig) -> dict:
     """What stage ``evaluate`` reads, typed (keyed by config section)."""
     from vnrrt.evaluation.config import EvalConfig, Rules, StatsConfig
 
-    return {
-        "paths": section(cfg, "paths", Paths),
-        "eval": section(cfg, "eval", EvalConfig),
-        "stats": section(cfg, "stats", StatsConfig),
-        "planner": section(cfg, "planner", Rules),
-    }
+    return sections(cfg, paths=Paths, eval=EvalConfig, stats=StatsConfig, planner=Rules)
 
 
 def run_evaluate(cfg: DictConfig) -> dict:
@@ -82,13 +77,8 @@ def report_settings(cfg: DictConfig) -> dict:
     from vnrrt.evaluation.config import EvalConfig, Rules
     from vnrrt.tracking import LoggerConfig
 
-    return {
-        "paths": section(cfg, "paths", Paths),
-        "eval": section(cfg, "eval", EvalConfig),
-        "planner": section(cfg, "planner", Rules),
-        "logger": section(cfg, "logger", LoggerConfig),
-        "scale": {"name": str(cfg.scale.name)},
-    }
+    typed = sections(cfg, paths=Paths, eval=EvalConfig, planner=Rules, logger=LoggerConfig)
+    return typed | {"scale": {"name": str(cfg.scale.name)}}
 
 
 def run_report(cfg: DictConfig) -> Path:

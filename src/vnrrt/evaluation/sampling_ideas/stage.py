@@ -15,7 +15,7 @@ from pathlib import Path
 
 from omegaconf import DictConfig
 
-from vnrrt.config import ConfigError, section
+from vnrrt.config import ConfigError, section, sections
 from vnrrt.evaluation.config import Configurations, OracleConfig, RegimeConfig, mask_taus
 from vnrrt.paths import Paths
 
@@ -86,16 +86,9 @@ def ideas_settings(cfg: DictConfig) -> dict:
     from vnrrt.evaluation.config import Rules, StatsConfig
     from vnrrt.tracking import LoggerConfig
 
-    return {
-        "paths": section(cfg, "paths", Paths),
-        "eval": section(cfg, "eval", Configurations),
-        "oracle": section(cfg, "oracle", OracleConfig),
-        "regime": section(cfg, "regime", RegimeConfig),
-        "planner": section(cfg, "planner", Rules),
-        "stats": section(cfg, "stats", StatsConfig),
-        "logger": section(cfg, "logger", LoggerConfig),
-        "scale": {"name": str(cfg.scale.name)},
-    }
+    typed = sections(cfg, paths=Paths, eval=Configurations, oracle=OracleConfig)
+    typed |= sections(cfg, regime=RegimeConfig, planner=Rules, stats=StatsConfig)
+    return typed | sections(cfg, logger=LoggerConfig) | {"scale": {"name": str(cfg.scale.name)}}
 
 
 def _study(s: dict) -> Study:
