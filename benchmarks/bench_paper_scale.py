@@ -123,7 +123,7 @@ def trials_hours(per_trial: pd.Series, ratio: float, cfg) -> tuple[float, int, l
     planner configurations whose rate was borrowed."""
     ev = section(cfg, "eval", EvalConfig)
     planner = section(cfg, "planner", PlannerConfig)
-    specs = configurations(ev, mask_taus(planner.taus, planner.tau))
+    specs = configurations(ev, mask_taus(planner.taus, planner.tau), planner.tau)
     n_inst = {"named": 5, "random": ev.random_maps}
     seconds, count, borrowed = 0.0, 0, set()
     for (kind, stop), per_instance in trial_counts(ev).items():

@@ -64,7 +64,8 @@ def test_display_names_and_order():
         "m_vnrrt_star@0.9",
         "rrt_star+informed",
     ]
-    assert ConfigKey.parse("m_vnrrt_star@0.5+informed").short == "m0.5+informed"
+    assert ConfigKey.parse("m_vnrrt_star@0.5+informed").short == "m0.5_informed"
+    assert ConfigKey.parse("m_vnrrt_star@0.5{max}[nrrtnet]").short == "m0.5_max_nrrtnet"
 
 
 @pytest.mark.parametrize(

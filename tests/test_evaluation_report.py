@@ -3,13 +3,17 @@ the paper's rows, display names and plain-text cells."""
 
 import numpy as np
 import pandas as pd
+import yaml
 
 from vnrrt.evaluation.paper_comparison.report import (
     MetricSettings,
+    ReportInputs,
     build_report,
     cell,
     networks_section,
 )
+from vnrrt.evaluation.config import StatsConfig
+from vnrrt.evaluation.paper_comparison.paper_noise import ratio_interval
 from vnrrt.evaluation.paper_comparison.summary import analyze
 from vnrrt.evaluation.paper_tables import load_paper_tables
 from vnrrt.evaluation.table import COLUMNS, conform
@@ -91,17 +95,27 @@ def test_cells_show_censoring_and_fallbacks():
 
 def test_report_on_a_synthetic_table(repo):
     paper = load_paper_tables(repo / "reports/paper/tables.yaml")
-    summary = analyze(synthetic_trials(), paper, eps=0.01, n_boot=300, level=0.95)
+    st = StatsConfig(bootstrap=300, level=0.95)
+    summary = analyze(synthetic_trials(), paper, 0.01, st, {"vertexnet": 15.0, "nrrtnet": 14.0})
     optima = {"map_1": {"astar": 110.0, "exact": 100.0, "taut": 101.0}}
+    settings = yaml.safe_load((repo / "reports/paper/settings.yaml").read_text())
+    values = {e["key"]: 0.5 for e in settings["settings"] if e.get("key")}
+    trainings = {"vertexnet": {"steps": 10, "batch_size": 8, "train_images": 80,
+                               "fit_seconds": 60.0, "network": {"encoder": "resnet18",
+                               "params_total": 1234, "weights": "none"}}}  # fmt: skip
     text = build_report(
-        summary,
-        paper,
-        optima,
-        {"vertexnet": 15.0, "nrrtnet": 14.0},
-        {"nrrt_star": "nrrtnet", "vnrrt_star": "vertexnet", "m_vnrrt_star@0.5": "vertexnet"},
-        "synthetic",
-        {},
-        METRICS,
+        ReportInputs(
+            summary,
+            paper,
+            optima,
+            {"nrrt_star": "nrrtnet", "vnrrt_star": "vertexnet", "m_vnrrt_star@0.5": "vertexnet"},
+            "synthetic",
+            {},
+            METRICS,
+            settings,
+            values,
+            trainings,
+        )
     )
     assert "| NRRT* | paper | 36.48±37.57" in text and "<br>" not in text
     assert "fallback" in text and ">=" in text  # M-VNRRT*'s censored failures are shown
@@ -112,6 +126,12 @@ def test_report_on_a_synthetic_table(repo):
     )
     assert "different map" not in line  # random maps are comparable
     assert "same direction" in line or "reproduced" in line  # ours: ~2x, paper 1.77x
+    level = summary["claims"]["corrected_level"]  # Bonferroni over the claims with data
+    iv = ratio_interval((19.38, 62.62, 100), (10.96, 62.67, 100), level)  # Table 3, random
+    assert f"[{iv.low:+.1%}, {iv.high:+.1%}] (n.s.)" in line  # the paper's own interval
+    assert "compatible with the paper's data" in line
+    assert "| heatmap draw probability | 0.5 (`planner.mix`)" in text
+    assert "| vertexnet (synthetic) | resnet18 U-Net" in text and "from scratch" in text
     map3 = next(ln for ln in text.splitlines() if "on Map 3" in ln)
     assert "no data" in map3  # no map_3 in this table
     assert "| ours: exact continuous optimum | 100 |" in text

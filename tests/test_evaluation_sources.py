@@ -114,7 +114,8 @@ def test_mixing_goes_from_the_oracle_to_uniform(turning):
 def test_the_study_has_every_idea_and_parses_its_keys():
     nets = {"nrrt_star": "nrrtnet", "vnrrt_star": "vertexnet", "m_vnrrt_star": "vertexnet"}
     ev = Configurations(sources=nets, informed=True)
-    keys = [k.text for k in oracle_keys(OracleConfig(qualities=[1.0, 0.1]), ev, [0.5, 0.9])]
+    oc = OracleConfig(qualities=[1.0, 0.1])
+    keys = [k.text for k in oracle_keys(oc, ev, [0.5, 0.9], 0.5)]
     assert len(keys) == len(set(keys))
     for key in (
         "rrt_star",
@@ -139,8 +140,8 @@ def test_the_oracle_study_runs_the_configured_planners_and_informed_flag():
     (no default stands in for them)."""
     nets = {"nrrt_star": "nrrtnet", "vnrrt_star": "vertexnet", "m_vnrrt_star": "vertexnet"}
     ev = Configurations(planners=["rrt_star", "vnrrt_star"], sources=nets, informed=False)
-    keys = [k.text for k in oracle_keys(OracleConfig(kinds=["oracle_path"], qualities=[1.0]),
-                                        ev, [0.5])]  # fmt: skip
+    oc = OracleConfig(kinds=["oracle_path"], qualities=[1.0])
+    keys = [k.text for k in oracle_keys(oc, ev, [0.5], 0.5)]
     assert keys == ["rrt_star", "vnrrt_star", "nrrt_star[oracle_path]"]
 
 

@@ -44,6 +44,7 @@ class Paths:
     report: str
     ideas_report: str
     paper_tables: str
+    paper_settings: str
     named_maps_figure: str
     heatmaps_figure: str
     data_metrics: str

@@ -187,10 +187,11 @@ class LoggerConfig:
 
 
 def metric_name(*parts: str) -> str:
-    """An MLflow metric name from parts (``@`` is not allowed in names: ``_tau``)."""
-    return "/".join(
-        p.replace("@", "_tau").replace("[", "(").replace("]", ")").replace("+", "_") for p in parts
-    )
+    """An MLflow metric name from parts joined by ``/``: ``@`` becomes ``_tau``, any other
+    character MLflow does not allow in a name (``[]{}()+``...) ``_``."""
+    import re
+
+    return "/".join(re.sub(r"[^\w\-. :/]", "_", p.replace("@", "_tau")) for p in parts)
 
 
 def flat_metrics(tree: dict, prefix: tuple = ()) -> dict[str, float]:

@@ -11,7 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from vnrrt.config import ConfigError, check, check_parts
-from vnrrt.evaluation.keys import ConfigKey
+from vnrrt.evaluation.keys import MASK_VARIANTS, ConfigKey
 from vnrrt.evaluation.sources import ORACLE_KINDS
 from vnrrt.names import PLANNERS, mask_taus
 
@@ -28,9 +28,21 @@ class Configurations:
     # planner -> heatmap source it samples (a network name of `networks`, or an oracle)
     sources: dict[str, str] = field(default_factory=lambda: dict(DEFAULT_SOURCES))
     informed: bool = True  # also every configuration with informed sampling (random maps)
+    mask_variants: list[str] = field(default_factory=list)  # M-VNRRT* at planner.tau, masked so
+    masked_controls: bool = False  # M-VNRRT* at planner.tau on the NRRT* network's heatmap
+    endpoint_radius: float = 3.0  # start/goal disks (px): the noends mask, the mass shares
 
     def validate(self) -> None:
         """Raise :class:`ConfigError` naming the first invalid value."""
+        bad = sorted(set(self.mask_variants) - set(MASK_VARIANTS))
+        check(not bad, "eval.mask_variants", self.mask_variants, f"known: {list(MASK_VARIANTS)}")
+        check(isinstance(self.masked_controls, bool), "eval.masked_controls",
+              self.masked_controls, "true or false")  # fmt: skip
+        ok = self.endpoint_radius >= 0
+        check(ok, "eval.endpoint_radius", self.endpoint_radius, "must be >= 0 px")
+        if self.masked_controls:
+            check("nrrt_star" in self.sources, "eval.masked_controls", True,
+                  "needs eval.sources.nrrt_star (the path network)")  # fmt: skip
         unknown = sorted(set(self.planners) - set(PLANNERS))
         if unknown or not self.planners:
             raise ConfigError(f"invalid eval.planners {self.planners}: known {PLANNERS}")
@@ -90,16 +102,24 @@ class Rules:
 
 @dataclass
 class StatsConfig:
-    """The ``stats`` section: bootstrap confidence intervals of the reports."""
+    """The ``stats`` section: bootstrap confidence intervals and the verdict rules."""
 
     bootstrap: int = 2000  # resamples of every confidence interval
-    level: float = 0.95  # confidence level of intervals and verdicts
+    level: float = 0.95  # confidence level of intervals and verdicts (family-wise for claims)
+    tail_draws: int = 50  # bootstrap draws in each tail at the claims' corrected level
+    untestable_endpoint_share: float = 0.5  # a masked sampler with more on start/goal ...
+    untestable_fallback: float = 0.5  # ... or falling back to uniform more often: untestable
 
     def validate(self) -> None:
         if not isinstance(self.bootstrap, int) or self.bootstrap < 100:
             raise ConfigError(f"invalid config value stats.bootstrap={self.bootstrap!r}: >= 100")
         if not 0.5 < self.level < 1:
             raise ConfigError(f"invalid config value stats.level={self.level!r}: in (0.5, 1)")
+        ok = isinstance(self.tail_draws, int) and self.tail_draws >= 1
+        check(ok, "stats.tail_draws", self.tail_draws, "an integer >= 1")
+        for name in ("untestable_endpoint_share", "untestable_fallback"):
+            v = getattr(self, name)
+            check(0 < v <= 1, f"stats.{name}", v, "must be in (0, 1]")
 
 
 @dataclass

@@ -5,13 +5,15 @@ statistics, reports, figures and MLflow runs all go through it.
 
 Text form (the ``key`` column of the trial tables)::
 
-    planner[@tau][[source]][+informed]
+    planner[@tau][{mask variant}][[source]][+informed]
 
 * ``rrt_star``, ``vnrrt_star``, ``m_vnrrt_star@0.5``: a configuration of the protocol; a
   learned planner samples the source the configuration assigns it (``eval.sources``), which
   the text leaves out;
 * ``vnrrt_star[oracle_vertex]``, ``nrrt_star[oracle_path@q0.1]``: the source is named (an
   oracle, :mod:`vnrrt.evaluation.sources`, or another network);
+* ``m_vnrrt_star@0.5{max}``, ``{noends}``: M-VNRRT*'s mask applied another way
+  (:data:`MASK_VARIANTS`: tau on the max-normalised heatmap; start/goal disks left out);
 * ``+informed``: the same configuration with informed sampling (Gammell et al. 2014).
 """
 
@@ -26,6 +28,10 @@ from vnrrt.config import ConfigError
 from vnrrt.names import PLANNER_NAMES, PLANNERS
 
 INFORMED = "+informed"  # text suffix of a configuration with informed sampling
+MASK_VARIANTS = {  # M-VNRRT*'s mask, other than on the raw probabilities (the paper's reading)
+    "max": "max-normalised",  # tau applied to heatmap / max(heatmap), as for the oracles
+    "noends": "without start/goal",  # the start and goal disks zeroed before the mask
+}
 SHORT = {"rrt_star": "rrt", "nrrt_star": "nrrt", "vnrrt_star": "vnrrt", "m_vnrrt_star": "m"}
 
 
@@ -44,6 +50,7 @@ class ConfigKey:
     source: str | None = None
     informed: bool = False
     named_source: bool = False
+    mask: str = ""  # a key of MASK_VARIANTS ("": the raw probabilities, the paper's)
 
     def __post_init__(self) -> None:
         if self.planner not in PLANNERS:
@@ -56,11 +63,16 @@ class ConfigKey:
             raise ConfigError(f"{self.planner}: tau must be finite, got {self.tau!r}")
         if self.named_source and self.source is None:
             raise ConfigError(f"{self.planner}: a named source needs a source")
+        if self.mask and (self.mask not in MASK_VARIANTS or self.tau is None):
+            raise ConfigError(
+                f"mask variant {self.mask!r}: M-VNRRT* only, one of {list(MASK_VARIANTS)}"
+            )
 
     @property
     def text(self) -> str:
         """The key's one written form (module doc)."""
         out = self.planner if self.tau is None else f"{self.planner}@{self.tau:g}"
+        out += f"{{{self.mask}}}" if self.mask else ""
         if self.named_source:
             out += f"[{self.source}]"
         return out + (INFORMED if self.informed else "")
@@ -77,6 +89,9 @@ class ConfigKey:
         base, bracket, rest = body.partition("[")
         if bracket and (not rest.endswith("]") or len(rest) < 2 or "[" in rest):
             raise ConfigError(f"bad configuration {text!r}: expected planner[@tau][[source]]")
+        base, brace, mask = base.partition("{")
+        if brace and not mask.endswith("}"):
+            raise ConfigError(f"bad configuration {text!r}: expected planner@tau{{variant}}")
         planner, at, tau = base.partition("@")
         try:
             value = float(tau) if at else None
@@ -87,13 +102,17 @@ class ConfigKey:
         if planner == "rrt_star" and not named:
             source = None
         try:
-            return cls(planner, value, source, body != text, bool(named))
+            return cls(planner, value, source, body != text, bool(named), mask[:-1])
         except ConfigError as err:
             raise ConfigError(f"bad configuration {text!r}: {err}") from None
 
     def with_source(self, source: str) -> ConfigKey:
         """This configuration sampling ``source`` instead (named in the text)."""
         return dataclasses.replace(self, source=source, named_source=True)
+
+    def with_mask(self, mask: str) -> ConfigKey:
+        """This M-VNRRT* configuration with mask variant ``mask`` (:data:`MASK_VARIANTS`)."""
+        return dataclasses.replace(self, mask=mask)
 
     def with_informed(self, informed: bool = True) -> ConfigKey:
         """This configuration with (or without) informed sampling."""
@@ -104,6 +123,7 @@ class ConfigKey:
         """The display name: ``M-VNRRT* τ=0.5``, ``VNRRT* [oracle_vertex]``,
         ``Informed RRT*``, ``informed NRRT*``."""
         name = PLANNER_NAMES[self.planner] + ("" if self.tau is None else f" τ={self.tau:g}")
+        name += f" ({MASK_VARIANTS[self.mask]})" if self.mask else ""
         name += f" [{self.source}]" if self.named_source else ""
         if not self.informed:
             return name
@@ -111,10 +131,12 @@ class ConfigKey:
 
     @property
     def short(self) -> str:
-        """A short name for metric keys: ``rrt``, ``m0.5``, ``nrrt+informed``."""
+        """A short name for metric keys (MLflow's characters only): ``rrt``, ``m0.5``,
+        ``m0.5_max``, ``m0.5_nrrtnet``, ``nrrt_informed``."""
         out = SHORT[self.planner] + ("" if self.tau is None else f"{self.tau:g}")
-        out += f"({self.source})" if self.named_source else ""
-        return out + (INFORMED if self.informed else "")
+        out += f"_{self.mask}" if self.mask else ""
+        out += f"_{self.source}" if self.named_source else ""
+        return out + ("_informed" if self.informed else "")
 
     def rank(self) -> tuple:
         """Sort order: not informed first, then the paper's planner order, tau, source."""
@@ -123,6 +145,7 @@ class ConfigKey:
             PLANNERS.index(self.planner),
             -1.0 if self.tau is None else self.tau,
             self.source if self.named_source else "",
+            self.mask,
         )
 
 

@@ -34,10 +34,13 @@ STOPS = ("initial", "optimal", "optimal_any_angle")
 TRIALS_PER_JOB = 25
 
 
-def configurations(ev: Configurations, taus: list[float]) -> list[ConfigKey]:
+def configurations(ev: Configurations, taus: list[float], tau: float) -> list[ConfigKey]:
     """The paper's configurations: every planner of ``ev.planners`` sampling its source of
     ``ev.sources``, M-VNRRT* once per threshold in ``taus`` (sorted, each once); with
-    ``ev.informed`` each again with informed sampling (run on the random instances only)."""
+    ``ev.informed`` each again with informed sampling (run on the random instances only);
+    then, at the claims' threshold ``tau`` (``planner.tau``), M-VNRRT* with each mask variant
+    of ``ev.mask_variants`` and, with ``ev.masked_controls``, on the path network's heatmap
+    (the masked NRRT* control, ``m_vnrrt_star@tau[<nrrt_star's source>]``)."""
     keys = []
     for p in ev.planners:
         if p == "rrt_star":
@@ -48,6 +51,11 @@ def configurations(ev: Configurations, taus: list[float]) -> list[ConfigKey]:
             keys.append(ConfigKey(p, None, ev.sources[p]))
     if ev.informed:
         keys += [k.with_informed() for k in list(keys)]
+    if "m_vnrrt_star" in ev.planners:
+        masked = ConfigKey("m_vnrrt_star", float(tau), ev.sources["m_vnrrt_star"])
+        keys += [masked.with_mask(m) for m in ev.mask_variants]
+        if ev.masked_controls:
+            keys.append(masked.with_source(ev.sources["nrrt_star"]))
     return keys
 
 

@@ -242,3 +242,47 @@ def source_target(source: str, network_targets: dict[str, str]) -> str:
     if is_oracle(source):
         return TARGET[parse_source(source)[0]]
     return network_targets.get(source, "path")
+
+
+def mask_variant(heatmap: np.ndarray, variant: str, inst, endpoint_radius: float) -> np.ndarray:
+    """``heatmap`` ``(H, W)`` prepared for M-VNRRT*'s mask variant
+    (:data:`vnrrt.evaluation.keys.MASK_VARIANTS`): ``max`` divides it by its maximum (so tau
+    reads as for the max-normalised oracles), ``noends`` zeroes the disks of
+    ``endpoint_radius`` px around the start and goal cells; ``""`` leaves it."""
+    h = np.asarray(heatmap, np.float64)
+    if variant == "max":
+        top = h.max()
+        return h / top if top > 0 else h
+    if variant == "noends":
+        return np.where(endpoint_disks(inst, endpoint_radius), 0.0, h)
+    if variant:
+        raise ValueError(f"unknown mask variant {variant!r}")
+    return h
+
+
+def endpoint_disks(inst, radius: float) -> np.ndarray:
+    """``(H, W)`` bool: the cells within ``radius`` px of the instance's start or goal cell."""
+    from vnrrt.data.targets import dilate
+
+    return dilate(target_mask(inst, "endpoints"), radius)
+
+
+def mass_shares(weights: np.ndarray, inst, radius: float, endpoint_radius: float) -> dict:
+    """Where a sampler's heatmap weights ``(H, W)`` lie, as shares of their total (NaN when
+    they have none): ``mass_endpoints`` on the start/goal disks (``endpoint_radius``),
+    ``mass_interior`` within ``radius`` px of the A* label's interior vertices (off those
+    disks), ``mass_path`` within ``radius`` of the rest of the path (off both)."""
+    from vnrrt.data.targets import dilate
+
+    w = np.asarray(weights, np.float64)
+    total = w.sum()
+    if not total > 0:
+        return {"mass_endpoints": math.nan, "mass_interior": math.nan, "mass_path": math.nan}
+    ends = endpoint_disks(inst, endpoint_radius)
+    interior = dilate(target_mask(inst, "interior_vertices"), radius) & ~ends
+    path = dilate(target_mask(inst, "path"), radius) & ~ends & ~interior
+    return {
+        "mass_endpoints": float(w[ends].sum() / total),
+        "mass_interior": float(w[interior].sum() / total),
+        "mass_path": float(w[path].sum() / total),
+    }

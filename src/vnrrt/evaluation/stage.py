@@ -72,7 +72,7 @@ def run_trials_part(cfg: DictConfig, part: int) -> int:
     paths, ev, planner = s["paths"], s["eval"], s["planner"]
     if part not in ev.parts:
         raise ConfigError(f"part {part} is not in eval.parts {ev.parts}")
-    keys = configurations(ev, mask_taus(planner.taus, planner.tau))
+    keys = configurations(ev, mask_taus(planner.taus, planner.tau), planner.tau)
     jobs = trial_jobs(Instances(paths.instances).kinds, keys, trial_counts(ev))
     jobs = part_jobs(jobs, part, len(ev.parts))
     networks = sorted({k.source for k in keys if k.source is not None})
@@ -82,7 +82,7 @@ def run_trials_part(cfg: DictConfig, part: int) -> int:
     log.info(
         "part %d/%d: %d trial jobs on %d instances", part, len(ev.parts), len(jobs), len(instances)
     )
-    heat = HeatSettings(radius=s["oracle"]["radius"], targets=targets)
+    heat = HeatSettings(s["oracle"]["radius"], ev.endpoint_radius, targets)
     table = run_jobs(jobs, instances, s["seed"], s["workers"], planner, heat)
     write_table(table, paths.trials_part(part))
     return len(table)

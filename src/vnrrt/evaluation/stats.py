@@ -35,7 +35,7 @@ VERDICTS = (
     "reproduced",
     "same direction, smaller effect",
     "same direction, larger effect",
-    "not reproduced",
+    "no clear effect",
     "reversed",
 )
 
@@ -269,13 +269,13 @@ def verdict(quoted: float, ci_low: float, ci_high: float) -> str:
     * ``reproduced``: the CI excludes 0 on the quoted side and contains the quoted value;
     * ``same direction, smaller effect`` / ``larger effect``: the CI excludes 0 on the quoted
       side, but the quoted value lies outside it;
-    * ``not reproduced``: the CI contains 0 (no clear effect either way);
+    * ``no clear effect``: the CI contains 0 (no effect either way);
     * ``reversed``: the CI excludes 0 on the other side.
     """
     if not (np.isfinite(ci_low) and np.isfinite(ci_high)):
-        return "not reproduced"
+        return "no clear effect"
     if ci_low <= 0 <= ci_high:
-        return "not reproduced"
+        return "no clear effect"
     if (ci_low > 0) != (quoted > 0):
         return "reversed"
     if ci_low <= quoted <= ci_high:

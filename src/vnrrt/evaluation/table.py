@@ -61,6 +61,10 @@ class TrialRow:
     convergence: tuple[float, ...] = ()  # s to CONVERGENCE_FACTORS x reference (optimal)
     regime: str = ""  # planner settings of a regime-sweep cell ('' = the protocol's)
     heat_mass: float = math.nan  # share of the heatmap's mass within r px of its target
+    # where the sampler's heatmap weights lie (after M-VNRRT*'s mask; vnrrt.evaluation.sources)
+    mass_endpoints: float = math.nan  # on the start/goal disks
+    mass_interior: float = math.nan  # near the interior vertices
+    mass_path: float = math.nan  # near the rest of the path
 
     def record(self) -> dict:
         """The row as ``{column: value}`` (convergence times as ``t_<f>x`` columns)."""

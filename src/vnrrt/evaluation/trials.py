@@ -18,6 +18,7 @@ import math
 import time
 from dataclasses import dataclass
 
+import numpy as np
 import pandas as pd
 
 from vnrrt.data.instances import EvalInstance
@@ -32,17 +33,20 @@ from vnrrt.planners import PlannerConfig, make_sampler, plan, warmup
 @dataclass(frozen=True)
 class HeatSettings:
     """How heatmaps are measured and oracle heatmaps built: ``radius`` (px) of "mass near the
-    target" (``oracle.radius``), the target of each trained network (``'path'`` or
-    ``'interior_vertices'``), and the oracles' blur ``sigma`` (px) and uniform ``floor``
-    (``oracle.sigma``, ``oracle.floor``; None where a stage samples no oracle)."""
+    target" (``oracle.radius``), the start/goal disks' ``endpoint_radius`` (px,
+    ``eval.endpoint_radius``: the ``noends`` mask and the mass shares), the target of each
+    trained network (``'path'`` or ``'interior_vertices'``), and the oracles' blur ``sigma``
+    (px) and uniform ``floor`` (``oracle.sigma``, ``oracle.floor``; None where a stage samples
+    no oracle)."""
 
     radius: float
+    endpoint_radius: float
     targets: dict[str, str]
     sigma: float | None = None
     floor: float | None = None
 
 
-def _row(job, inst, trial, seed, result, setup, ref, mass) -> TrialRow:
+def _row(job, inst, trial, seed, result, setup, ref, mass, shares) -> TrialRow:
     key = job.key
     return TrialRow(
         seq=job.seq + trial - job.first,
@@ -71,6 +75,7 @@ def _row(job, inst, trial, seed, result, setup, ref, mass) -> TrialRow:
         convergence=tuple(m.time for m in result.milestones),
         regime=job.regime,
         heat_mass=mass,
+        **shares,
     )
 
 
@@ -87,11 +92,14 @@ def run_job(
     if key.informed:
         config = config.replace(informed=True)
     warmup()
-    heatmap, mass = None, math.nan
+    heatmap, mass, shares = None, math.nan, {}
     if key.source is not None:
         heatmap = sources.source_heatmap(key.source, inst, heat.sigma, heat.floor)
+        heatmap = sources.mask_variant(heatmap, key.mask, inst, heat.endpoint_radius)
         mask = sources.target_mask(inst, sources.source_target(key.source, heat.targets))
         mass = sources.mass_near(heatmap, mask, heat.radius)
+        weights = heatmap if key.tau is None else np.where(heatmap >= key.tau, heatmap, 0.0)
+        shares = sources.mass_shares(weights, inst, heat.radius, heat.endpoint_radius)
     tick = time.perf_counter()
     sampler = make_sampler(key.planner, inst.grid.shape, heatmap, key.tau, config.mix)
     setup = time.perf_counter() - tick
@@ -112,7 +120,7 @@ def run_job(
             milestones=milestones,
             config=config,
         )
-        rows.append(_row(job, inst, trial, s, r, setup, ref, mass))
+        rows.append(_row(job, inst, trial, s, r, setup, ref, mass, shares))
     return rows
 
 
@@ -162,4 +170,4 @@ def run_trials(
     return run_jobs(jobs, by_index, seed, workers, config or PlannerConfig(), heat or LIBRARY_HEAT)
 
 
-LIBRARY_HEAT = HeatSettings(radius=3.0, targets={}, sigma=1.0, floor=0.0)  # conf/oracle's
+LIBRARY_HEAT = HeatSettings(3.0, 3.0, {}, sigma=1.0, floor=0.0)  # conf/oracle's, conf/eval's

@@ -238,6 +238,9 @@ def run_train(cfg: DictConfig, network: str) -> dict:
 
         metrics["checkpoint_sha256"] = write_checksum(out)
         metrics["threads"] = threads
+        metrics["batch_size"] = batch
+        metrics["network"] = record["describe"]  # architecture, initialisation, parameters
+        metrics["target"] = record["target"]
         write_json(metrics_file, metrics)
         shutil.rmtree(paths.run_folder(network), ignore_errors=True)
     return metrics

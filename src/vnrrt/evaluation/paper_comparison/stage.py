@@ -14,7 +14,8 @@ import dataclasses
 import logging
 from pathlib import Path
 
-from omegaconf import DictConfig
+import yaml
+from omegaconf import DictConfig, OmegaConf
 
 from vnrrt.config import sections
 from vnrrt.paths import Paths
@@ -36,17 +37,19 @@ def run_evaluate(cfg: DictConfig) -> dict:
     from vnrrt.evaluation.paper_tables import load_paper_tables
     from vnrrt.evaluation.protocol import configurations, trial_counts, trial_jobs
     from vnrrt.evaluation.table import merge_parts, write_table
-    from vnrrt.io import write_json, write_text
+    from vnrrt.io import read_json, write_json, write_text
 
     s = evaluate_settings(cfg)
     paths, ev, st, rules = s["paths"], s["eval"], s["stats"], s["planner"]
-    keys = configurations(ev, rules.mask_taus)
+    keys = configurations(ev, rules.mask_taus, rules.tau)
     jobs = trial_jobs(Instances(paths.instances).kinds, keys, trial_counts(ev))
     table = merge_parts(paths.trials, ev.parts, sum(j.count for j in jobs))
     write_table(table, paths.trials_table)
     paper = load_paper_tables(paths.paper_tables)
     eps = rules.eps
-    summary = analyze(table, paper, eps, st.bootstrap, st.level)
+    networks = read_json(paths.predict_metrics)["networks"]
+    inference = {n: float(m["ms_per_map"]) for n, m in networks.items()}
+    summary = analyze(table, paper, eps, st, inference)
     write_json(paths.summary, summary)
     curves = convergence_curves(table, eps)
     write_text(paths.convergence, curves.to_csv(index=False))
@@ -73,36 +76,55 @@ def series_per_map_set(curves) -> dict:
 
 
 def report_settings(cfg: DictConfig) -> dict:
-    """What stage ``report`` reads, typed (keyed by config section)."""
-    from vnrrt.evaluation.config import EvalConfig, Rules
+    """What stage ``report`` reads, typed (keyed by config section); ``values``: the run's
+    value of every setting the settings table names (``paths.paper_settings``)."""
+    from vnrrt.evaluation.config import EvalConfig
+    from vnrrt.planners.config import PlannerConfig
     from vnrrt.tracking import LoggerConfig
 
-    typed = sections(cfg, paths=Paths, eval=EvalConfig, planner=Rules, logger=LoggerConfig)
-    return typed | {"scale": {"name": str(cfg.scale.name)}}
+    typed = sections(cfg, paths=Paths, eval=EvalConfig, planner=PlannerConfig)
+    typed |= sections(cfg, logger=LoggerConfig) | {"scale": {"name": str(cfg.scale.name)}}
+    settings = yaml.safe_load(Path(typed["paths"].paper_settings).read_text())
+    keys = [e["key"] for e in settings["settings"] if e.get("key")]
+    values = {k: OmegaConf.to_container(v) if OmegaConf.is_config(v := OmegaConf.select(cfg, k))
+              else v for k in keys}  # fmt: skip
+    values["scale.maps"] = int(cfg.scale.maps_per_shard) * len(cfg.scale.shards)
+    return typed | {"paper_settings": settings, "values": values}
 
 
 def run_report(cfg: DictConfig) -> Path:
     """Stage ``report`` (module doc); returns the report's path."""
     from vnrrt.data.instances import Instances
-    from vnrrt.evaluation.paper_comparison.report import build_report, headline, metric_settings
+    from vnrrt.evaluation.config import mask_taus
+    from vnrrt.evaluation.paper_comparison.report import (
+        ReportInputs,
+        build_report,
+        headline,
+        metric_settings,
+    )
     from vnrrt.evaluation.paper_tables import load_paper_tables
     from vnrrt.evaluation.protocol import configurations
     from vnrrt.io import read_json, write_json, write_text
 
     s = report_settings(cfg)
-    paths, ev, rules, logger, scale = s["paths"], s["eval"], s["planner"], s["logger"], s["scale"]
-    keys = configurations(ev, rules.mask_taus)
+    paths, ev, planner, logger, scale = s["paths"], s["eval"], s["planner"], s["logger"], s["scale"]
+    keys = configurations(ev, mask_taus(planner.taus, planner.tau), planner.tau)
     summary, predict = read_json(paths.summary), read_json(paths.predict_metrics)
     networks = predict["networks"]
+    trainings = {n: read_json(paths.train_metrics(n)) for n in networks}
     text = build_report(
-        summary,
-        load_paper_tables(paths.paper_tables),
-        Instances(paths.instances).optima(),
-        {n: float(m["ms_per_map"]) for n, m in networks.items()},
-        {k.text: k.source for k in keys if k.source},
-        scale["name"],
-        networks,
-        metric_settings(predict["settings"]),
+        ReportInputs(
+            summary,
+            load_paper_tables(paths.paper_tables),
+            Instances(paths.instances).optima(),
+            {k.text: k.source for k in keys if k.source},
+            scale["name"],
+            networks,
+            metric_settings(predict["settings"]),
+            s["paper_settings"],
+            s["values"],
+            trainings,
+        )
     )
     write_text(paths.report, text)
     figures = save_figures(paths, summary)
@@ -113,7 +135,7 @@ def run_report(cfg: DictConfig) -> Path:
 
         artifacts = [Path(paths.report), *figures, Path(paths.trials_table)]
         trainings = {n: paths.train_metrics(n) for n in sorted(set(ev.sources.values()))}
-        params = {"eval": dataclasses.asdict(ev), "planner": dataclasses.asdict(rules)}
+        params = {"eval": dataclasses.asdict(ev), "planner": dataclasses.asdict(planner)}
         log_evaluation(
             logger, scale["name"], params, ev.sources, summary, metrics, artifacts, trainings
         )

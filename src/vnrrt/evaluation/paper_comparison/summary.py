@@ -11,8 +11,9 @@ import numpy as np
 import pandas as pd
 
 from vnrrt.evaluation.keys import ConfigKey
+from vnrrt.evaluation.paper_comparison.claims import claims, mask_shares
 from vnrrt.evaluation.protocol import STOPS
-from vnrrt.evaluation.stats import Summary, bonferroni_level, compare, summarize, verdict
+from vnrrt.evaluation.stats import Summary, compare, summarize
 from vnrrt.evaluation.table import CONVERGENCE_COLUMNS, CONVERGENCE_FACTORS
 
 METRICS = {"time_to_stop": True, "iterations": True, "cost": False}  # metric -> censored
@@ -59,40 +60,6 @@ def speedups(
                 c = compare(base, plan, metric, n_boot=n_boot, level=level)
                 out.setdefault(stop, {}).setdefault(key, {})[map_set] = c.as_dict()
     return out
-
-
-def _claim_pair(table: pd.DataFrame, paper: dict, claim: dict):
-    """(baseline rows, planner rows) of a claim's table column; None if either is missing."""
-    stop = paper["tables"][claim["table"]]["stop"]
-    sel = table[(table["stop"] == stop) & (table["map_set"] == claim["column"])]
-    base, plan = sel[sel["key"] == claim["baseline"]], sel[sel["key"] == claim["planner"]]
-    return None if base.empty or plan.empty else (base, plan)
-
-
-def claims(table: pd.DataFrame, paper: dict, n_boot: int, level: float) -> dict:
-    """The paper's quoted improvements against ours, for time and iterations: our paired
-    speed-up and ratio of means with CIs, the verdict at ``level`` and at the
-    Bonferroni-corrected level over all tested (claim, metric) pairs, and whether the map
-    set is comparable (our named maps are not the paper's)."""
-    comparable = set(paper.get("comparable_columns", []))
-    pairs = [_claim_pair(table, paper, claim) for claim in paper["claims"]]
-    tests = 2 * sum(p is not None for p in pairs)
-    strict = bonferroni_level(level, tests)
-    rows = []
-    for claim, pair in zip(paper["claims"], pairs, strict=True):
-        row = {**claim, "comparable": claim["column"] in comparable}
-        for metric in ("time_to_stop", "iterations"):
-            if pair is None:
-                row[metric] = None
-                continue
-            c = compare(*pair, metric, n_boot=n_boot, level=level).as_dict()
-            wide = compare(*pair, metric, n_boot=n_boot, level=strict)
-            c["verdict"] = verdict(claim["quoted"], c["ci_low"] - 1, c["ci_high"] - 1)
-            c["bonferroni_ci"] = [wide.ci_low, wide.ci_high]
-            c["bonferroni_verdict"] = verdict(claim["quoted"], wide.ci_low - 1, wide.ci_high - 1)
-            row[metric] = c
-        rows.append(row)
-    return {"level": level, "tests": tests, "bonferroni_level": strict, "rows": rows}
 
 
 def convergence_curves(table: pd.DataFrame, eps: float) -> pd.DataFrame:
@@ -153,27 +120,43 @@ def informed_comparisons(table: pd.DataFrame, n_boot: int, level: float) -> dict
     return out
 
 
-def analyze(table: pd.DataFrame, paper: dict, eps: float, n_boot: int, level: float) -> dict:
+def with_inference(table: pd.DataFrame, inference_ms: dict[str, float]) -> pd.DataFrame:
+    """``table`` with ``time_total``: planning time plus the network's inference per map (s,
+    ``inference_ms``: network -> ms; 0 for RRT* and oracles)."""
+    extra = table["source"].map(lambda s: inference_ms.get(s, 0.0) / 1e3)
+    return table.assign(time_total=table["time_to_stop"] + extra)
+
+
+def analyze(
+    table: pd.DataFrame, paper: dict, eps: float, st, inference_ms: dict[str, float]
+) -> dict:
     """The whole summary (module doc) of a merged trial table, with the settings its numbers
-    were computed with (stop tolerance ``eps``, ``n_boot`` resamples, CI ``level``)."""
+    were computed with (stop tolerance ``eps``; ``st``, the ``stats`` section: resamples, CI
+    level, claim rules); ``inference_ms``: each network's inference per map (ms)."""
+    n_boot, level = st.bootstrap, st.level
     stops = [s for s in STOPS if s in set(table["stop"])]
     keys = list(dict.fromkeys(table["key"]))
+    shares = mask_shares(table)
+    timed = with_inference(table, inference_ms)
     return {
         "eps": eps,
         "level": level,
         "bootstrap": n_boot,
+        "inference_ms": dict(inference_ms),
+        "mask_shares": shares,
         "stops": stops,
         "keys": keys,
         "map_sets": list(dict.fromkeys(table["map_set"])),
         "cells": cells(table, n_boot, level),
         "over_rrt_star": {
-            m: speedups(table, "rrt_star", m, n_boot, level) for m in ("time_to_stop", "iterations")
+            m: speedups(timed, "rrt_star", m, n_boot, level)
+            for m in ("time_to_stop", "iterations", "time_total")
         },
         "over_nrrt_star": {
             m: speedups(table, "nrrt_star", m, n_boot, level)
             for m in ("time_to_stop", "iterations")
         },
-        "claims": claims(table, paper, n_boot, level),
+        "claims": claims(timed, paper, st, shares),
         "informed": informed_comparisons(table, n_boot, level),
         "setup_ms": {
             k: float(1e3 * sub["setup_time"].median())

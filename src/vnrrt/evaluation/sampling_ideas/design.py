@@ -25,9 +25,12 @@ from vnrrt.evaluation.sources import source_name
 QUALITY_IDEAS = ("oracle_path", "oracle_vertex")  # the oracles of the quality curve
 
 
-def oracle_keys(oc: OracleConfig, ev: Configurations, taus: list[float]) -> list[ConfigKey]:
-    """The oracle study's configurations (module doc), each once, in a fixed order."""
-    keys = configurations(ev, taus)  # RRT* and the trained networks, as configured
+def oracle_keys(
+    oc: OracleConfig, ev: Configurations, taus: list[float], tau: float
+) -> list[ConfigKey]:
+    """The oracle study's configurations (module doc), each once, in a fixed order; ``taus``
+    every M-VNRRT* threshold, ``tau`` the claims' (``planner.tau``)."""
+    keys = configurations(ev, taus, tau)  # RRT* and the trained networks, as configured
     for kind in oc.kinds:
         keys += idea_keys(kind, taus, 1.0)
     for q in oc.qualities:

@@ -29,10 +29,12 @@ class Study:
 
     paths: Paths
     sources: dict[str, str]  # eval.sources
+    endpoint_radius: float  # eval.endpoint_radius (px)
     configurations: Configurations | None  # eval's; None where only the sweep runs
     oracle: OracleConfig
     regime: RegimeConfig | None  # None where only the oracle study runs
     taus: list[float]
+    tau: float  # the claims' threshold (planner.tau)
 
     def design(self, which: str) -> tuple[list, dict, dict, list[int], int]:
         """``(keys, counts, cells, parts, instances)`` of the oracle study (``which=
@@ -41,7 +43,7 @@ class Study:
 
         if which == "oracle":
             o = self.oracle
-            keys = d.oracle_keys(o, self.configurations, self.taus)
+            keys = d.oracle_keys(o, self.configurations, self.taus, self.tau)
             return keys, d.oracle_counts(o), {"": {}}, o.parts, o.random_maps
         r = self.regime
         keys = d.regime_keys(r, self.sources)
@@ -71,7 +73,10 @@ def part_settings(cfg: DictConfig, which: str) -> dict:
         "paths": section(cfg, "paths", Paths),
         "eval": section(cfg, "eval", Configurations)
         if oracle_study
-        else {"sources": dict(cfg.eval.sources)},
+        else {
+            "sources": dict(cfg.eval.sources),
+            "endpoint_radius": float(cfg.eval.endpoint_radius),
+        },
         "oracle": section(cfg, "oracle", OracleConfig),
         "regime": None if oracle_study else section(cfg, "regime", RegimeConfig),
         "planner": section(cfg, "planner", PlannerConfig),
@@ -97,8 +102,12 @@ def _study(s: dict) -> Study:
     ev, planner = s["eval"], s["planner"]
     configurations = ev if isinstance(ev, Configurations) else None
     sources = ev.sources if configurations else ev["sources"]
+    ends = ev.endpoint_radius if configurations else ev["endpoint_radius"]
     taus = mask_taus(planner.taus, planner.tau)
-    return Study(s["paths"], dict(sources), configurations, s["oracle"], s["regime"], taus)
+    regime = s["regime"]
+    return Study(
+        s["paths"], dict(sources), ends, configurations, s["oracle"], regime, taus, planner.tau
+    )
 
 
 def _run_part(cfg: DictConfig, part: int, which: str) -> int:
@@ -119,7 +128,7 @@ def _run_part(cfg: DictConfig, part: int, which: str) -> int:
     indices = sorted({job.instance for job in jobs})
     predict_parts = settings["predict"]["parts"]
     instances, targets = load(s.paths.instances, indices, networks, s.paths.heatmaps, predict_parts)
-    heat = HeatSettings(s.oracle.radius, targets, s.oracle.sigma, s.oracle.floor)
+    heat = HeatSettings(s.oracle.radius, s.endpoint_radius, targets, s.oracle.sigma, s.oracle.floor)
     configs = {label: planner.replace(**over) for label, over in cells.items()}
     log.info(
         "%s part %d/%d: %d jobs on %d instances", which, part, len(parts), len(jobs), len(instances)
@@ -159,7 +168,7 @@ def run_ideas(cfg: DictConfig) -> dict:
         folder = s.paths.oracle if which == "oracle" else s.paths.regime
         rows = sum(j.count for j in s.jobs(which))
         tables[which] = merge_parts(folder, s.design(which)[3], rows)
-    networks = [k.text for k in configurations(s.configurations, s.taus) if k.source]
+    networks = [k.text for k in configurations(s.configurations, s.taus, s.tau) if k.source]
     pairs = claim_pairs(load_paper_tables(s.paths.paper_tables))
     shown = {"eps": rules.eps, "level": st.level, "bootstrap": st.bootstrap}
     shown |= {"radius": s.oracle.radius, "sigma": s.oracle.sigma, "floor": s.oracle.floor}
