@@ -149,3 +149,39 @@ def test_the_command_line_predicts_what_the_stage_predicted(predicted, tmp_path,
     other = int(np.flatnonzero(~(read_heatmaps(right)["keys"] == (-1, 2)).all(axis=1))[0])
     assert main([*plan, str(right), "--row", str(other)]) == 2
     assert "not the --map instance (-1, 2)" in capsys.readouterr().err
+
+
+def test_a_heatmap_or_network_made_for_something_else_is_refused(predicted, capsys):
+    """A pipeline heatmap belongs to its instance's own start and goal; a planner samples
+    its own network's target (vertex for VNRRT*/M-VNRRT*, path for NRRT*): the command line
+    refuses the others, naming both, and so does vnrrt.predict given a target."""
+    from vnrrt.cli import load_instance, main
+    from vnrrt.model.checkpoint import CheckpointError
+
+    cfg, _, _ = predicted
+    models, named = Path(cfg.paths.models), str(cfg.paths.named_maps)
+    files = [part_file(cfg.paths.heatmaps, k) for k in cfg.predict.parts]
+    right = next(f for f in files if ((read_heatmaps(f)["keys"] == (-1, 2)).all(axis=1)).any())
+    inst = load_instance(Path(named), "2")
+    swapped = ["--start", "{},{}".format(*inst["goal"]), "--goal", "{},{}".format(*inst["start"])]
+    base = ["plan", "--map", named, "--instance", "2"]
+    heat = [*base, "--heatmap", str(right), "--network"]
+    assert main([*heat, "vertexnet", "--planner", "vnrrt_star", *swapped]) == 2
+    assert "--start/--goal move them: predict one with --checkpoint" in capsys.readouterr().err
+    assert main([*heat, "vertexnet", "--planner", "nrrt_star"]) == 2
+    err = capsys.readouterr().err
+    assert (f"network vertexnet of {right} predicts vertex heatmaps, not the path heatmaps that "
+            "--planner nrrt_star samples") in err and err.count("\n") == 1  # fmt: skip
+    assert main([*heat, "nrrtnet", "--planner", "nrrt_star"]) == 0  # its own network
+    capsys.readouterr()
+    for planner in ("vnrrt_star", "m_vnrrt_star"):
+        extra = ["--tau", "0.5"] if planner == "m_vnrrt_star" else []
+        ckpt = str(models / "nrrtnet.ckpt")
+        assert main([*base, "--planner", planner, "--checkpoint", ckpt, *extra]) == 2
+        assert (f"network {ckpt} predicts path heatmaps, not the vertex heatmaps that --planner "
+                f"{planner} samples") in capsys.readouterr().err  # fmt: skip
+    grid = inst["grid"]
+    start, goal = (tuple(int(v) for v in inst[k]) for k in ("start", "goal"))  # their cells
+    with pytest.raises(CheckpointError, match="predicts path heatmaps, not the vertex"):
+        heatmap(models / "nrrtnet.ckpt", grid, start, goal, target="vertex")
+    assert heatmap(models / "nrrtnet.ckpt", grid, start, goal, target="path").shape == grid.shape

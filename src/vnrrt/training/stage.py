@@ -31,9 +31,11 @@ LOGGER_CALLBACKS = ("learning_rate_monitor", "prediction_figures")  # need an ML
 
 
 def network_spec(cfg: DictConfig, network: str) -> DictConfig:
-    """``networks.<network>`` (target, endpoints, resume); ``KeyError`` lists the known ones."""
+    """``networks.<network>`` (target, endpoints, resume); ``ConfigError`` lists the known ones."""
     if network not in cfg.networks:
-        raise KeyError(f"unknown network {network!r}; configured: {sorted(cfg.networks)}")
+        from vnrrt.config import ConfigError
+
+        raise ConfigError(f"unknown network {network!r}; configured: {sorted(cfg.networks)}")
     return cfg.networks[network]
 
 
@@ -129,11 +131,10 @@ def make_logger(cfg: DictConfig, network: str, record: dict):
     """The run's ``MLFlowLogger``: experiment per scale, tags, params, the config file."""
     from hydra.utils import instantiate
 
-    uri = tracking.tracking_uri(cfg.logger.uri)
     scale = str(cfg.scale.name)
-    exp = tracking.experiment_id(cfg.logger.experiment, uri, cfg.logger.artifact_location)
-    tags = tracking.run_tags(network, scale, fingerprint=record["fingerprint"])
-    tracking.mark_stale_runs(uri, exp, tags)
+    uri, _, tags = tracking.open_experiment(
+        cfg.logger, network, scale, fingerprint=record["fingerprint"]
+    )
     logger = instantiate(
         cfg.logger.lightning, run_name=f"{network} {scale}", tracking_uri=uri, tags=tags
     )
@@ -168,7 +169,9 @@ def fix_threads(threads: int | None) -> int:
 def run_train(cfg: DictConfig, network: str) -> dict:
     """Stage ``train@<network>``: train ``network`` as configured (module doc); returns and
     writes its metrics."""
-    tracking.configure(cfg.logger.uri)  # before Lightning (and its MLflow logger) is imported
+    uri = tracking.configure(cfg.logger.uri)  # before Lightning (and its MLflow logger) is imported
+    if cfg.logger.enabled:
+        tracking.check_store(uri)  # an unreachable server fails here, before any work
     import lightning as L
     from hydra.utils import instantiate
 
@@ -246,5 +249,6 @@ def log_model(cfg: DictConfig, network: str, checkpoint: Path, logger, datamodul
             input_example=example,
             registered_model_name=registered,
             serialization_format="pickle",
-            metadata={"render": dict(record["render"])},  # how to draw its input image
+            # how to draw its input image, and what it predicts (checked by vnrrt.predict)
+            metadata={"render": dict(record["render"]), "target": dict(record["target"])},
         )
