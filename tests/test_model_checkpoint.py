@@ -55,8 +55,9 @@ def save_legacy(ckpt: dict, path: Path) -> Path:
 
 def crafted_nets(victim: Path, created: Path) -> dict[str, dict]:
     """``record.net`` configs that ran code when a checkpoint was loaded through
-    ``hydra.utils.instantiate``: truncating ``victim``, writing ``created``."""
-    truncate = {"_target_": "os.truncate", "_args_": [str(victim), 0]}
+    ``hydra.utils.instantiate``: truncating ``victim`` (opened for writing; Hydra blocks
+    ``os.truncate`` but not ``open``), writing ``created``."""
+    truncate = {"_target_": "builtins.open", "_args_": [str(victim), "w"]}
     path = {"_target_": "pathlib.Path", "_args_": [str(created)]}
     write = {"_target_": "pathlib.Path.write_text", "_args_": [path, "pwned"]}
     return {

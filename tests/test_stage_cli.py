@@ -8,7 +8,6 @@ import pytest
 
 from tests.conftest import copy_pipeline
 from vnrrt.config import compose, dump
-from vnrrt.stage_cli import EXIT_INPUT, EXIT_INTERNAL, is_input_error, run_reporting
 
 
 @pytest.fixture(scope="module")
@@ -37,7 +36,7 @@ def test_bad_params_exit_2_with_one_line(work, tmp_path, setup, message):
     if setup:
         params.write_text(dump(compose(setup)))
     out = run_stage(work, "stages/validate.py", "--params", str(params))
-    assert out.returncode == EXIT_INPUT, out.stderr
+    assert out.returncode == 2, out.stderr
     assert message in out.stderr and out.stderr.count("\n") == 1, out.stderr
     assert "Traceback" not in out.stderr and out.stderr.startswith("stage validate: error: ")
 
@@ -50,7 +49,7 @@ def test_an_internal_error_of_a_stage_exits_3_with_its_traceback(work):
         "stage_main('validate', broken, 'a stage with a bug')\n"
     )
     out = run_stage(work, "stages/broken.py")
-    assert out.returncode == EXIT_INTERNAL, out.stderr
+    assert out.returncode == 3, out.stderr
     last = out.stderr.strip().splitlines()[-1]
     assert "Traceback" in out.stderr and "raise RuntimeError('boom')" in out.stderr
     assert last.startswith("stage validate: internal error (RuntimeError: boom)")
@@ -66,6 +65,8 @@ def test_errors_are_classed_as_input_or_internal(capsys):
     import zipfile
 
     from mlflow.exceptions import MlflowException
+
+    from vnrrt.stage_cli import EXIT_INPUT, is_input_error, run_reporting
 
     for err in (ValueError("x"), FileNotFoundError("x"), zipfile.BadZipFile("x"),
                 MlflowException("store down")):  # fmt: skip
