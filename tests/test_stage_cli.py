@@ -41,6 +41,11 @@ def test_bad_params_exit_2_with_one_line(work, tmp_path, setup, message):
     assert "Traceback" not in out.stderr and out.stderr.startswith("stage validate: error: ")
 
 
+def test_a_stage_that_succeeds_exits_0(work):
+    out = run_stage(work, "stages/validate.py")
+    assert out.returncode == 0, out.stderr
+
+
 def test_an_internal_error_of_a_stage_exits_3_with_its_traceback(work):
     script = work / "stages" / "broken.py"
     script.write_text(
