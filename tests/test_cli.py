@@ -1,6 +1,7 @@
-"""The command line: map and heatmap formats, named instances, references that follow the
-endpoints, exit codes, one-line errors without tracebacks, the figure, --version and
-``python -m vnrrt``."""
+"""The command line: map and heatmap formats (map images at any bit depth, transparency,
+0/1 occupancy), named instances, references that follow the endpoints, exit codes (an
+internal error is not a budget hit), one-line errors without tracebacks, the figure,
+--version and ``python -m vnrrt``."""
 
 import subprocess
 import sys
@@ -160,3 +161,66 @@ def test_an_edited_shard_beside_its_manifest_is_refused(tmp_path, capsys):
     assert "shard_0.npz does not match its checksum" in err and "\n" not in err
     with pytest.raises(ShardError, match="does not match its checksum"):
         verified_files(shards, tmp_path / "manifest.json", [0])  # as run_instances calls it
+
+
+def wall_png(path, bits: int, wall: float) -> None:
+    """A 40x40 gray picture at ``bits`` bits: white floor, a full-height wall of gray level
+    ``wall`` (in [0, 1]) in columns 18-21."""
+    full = 2**bits - 1
+    img = np.full((40, 40), full, np.uint8 if bits == 8 else np.uint16)
+    img[:, 18:22] = round(wall * full)
+    cv2.imwrite(str(path), img)
+
+
+@pytest.mark.parametrize("bits", [8, 16])
+def test_a_dark_gray_wall_is_an_obstacle_at_any_bit_depth(tmp_path, capsys, bits):
+    """A 30% gray wall is dark in an 8-bit and in a 16-bit PNG alike (it used to be free in
+    16 bits, where the threshold was the absolute value 128 of 65535)."""
+    wall_png(tmp_path / "map.png", bits, 0.3)
+    args = ["plan", "--map", str(tmp_path / "map.png"), "--goal", "35.5,20.5"]
+    assert main([*args, "--start", "19.5,20.5"]) == 2  # on the wall
+    assert "lies in an obstacle cell" in capsys.readouterr().err
+    assert main([*args, "--start", "5.5,20.5"]) == 1  # walled off: the budget runs out
+    assert "success=False" in capsys.readouterr().out
+
+
+def test_a_transparent_background_and_a_0_1_occupancy_png_are_free_space(tmp_path, capsys):
+    """Black ink on a transparent background (alpha 0) and a 0/1 occupancy image both plan
+    around their one wall (both used to read as all obstacle)."""
+    ink = np.zeros((40, 40, 4), np.uint8)
+    ink[10:40, 18:22, 3] = 255  # an opaque black wall from the bottom, open at the top
+    cv2.imwrite(str(tmp_path / "ink.png"), ink)
+    occupancy = (ink[..., 3] > 0).astype(np.uint8)
+    cv2.imwrite(str(tmp_path / "occ.png"), occupancy)
+    for name in ("ink.png", "occ.png"):
+        rc = main(["plan", "--map", str(tmp_path / name), "--start", "5.5,35.5",
+                   "--goal", "35.5,35.5", "--stop", "optimal"])  # fmt: skip
+        text = capsys.readouterr().out
+        assert rc == 0 and "success=True" in text, (name, text)
+        ratio = float(text.split("cost/A* ")[1].split()[0])
+        assert 0.9 < ratio <= 1.01  # the A* reference goes over the wall's top too
+
+
+def test_an_internal_error_exits_3_with_its_traceback_not_1(map_npy, capsys, monkeypatch):
+    """1 means "stopped on a budget"; an unexpected exception is a bug: status 3, the
+    traceback and one line saying so."""
+    import vnrrt.planners
+
+    def broken(*args, **kwargs):
+        raise RuntimeError("boom")
+
+    monkeypatch.setattr(vnrrt.planners, "plan", broken)
+    assert main(["plan", "--map", str(map_npy), "--start", "8.5,8.5", "--goal", "72.5,8.5"]) == 3
+    err = capsys.readouterr().err
+    assert "Traceback" in err and err.strip().splitlines()[-1].startswith(
+        "vnrrt plan: internal error (RuntimeError: boom)"
+    )
+
+
+def test_the_help_lists_every_exit_status():
+    help_text = subprocess.run([sys.executable, "-m", "vnrrt", "--help"], capture_output=True,
+                               text=True, check=True).stdout  # fmt: skip
+    flat = " ".join(help_text.split())
+    for status in ("0 success", "1 the planner stopped on a budget", "2 bad configuration",
+                   "3 an internal error"):  # fmt: skip
+        assert status in flat, status

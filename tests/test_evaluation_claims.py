@@ -16,6 +16,8 @@ from vnrrt.evaluation.paper_comparison.claims import (
     CONTRADICTS,
     claim_boot,
     compatibility,
+)
+from vnrrt.evaluation.paper_comparison.claims import (
     testability as masked_rule,
 )
 from vnrrt.evaluation.protocol import configurations

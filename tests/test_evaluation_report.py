@@ -5,6 +5,8 @@ import numpy as np
 import pandas as pd
 import yaml
 
+from vnrrt.evaluation.config import StatsConfig
+from vnrrt.evaluation.paper_comparison.paper_noise import ratio_interval
 from vnrrt.evaluation.paper_comparison.report import (
     MetricSettings,
     ReportInputs,
@@ -12,8 +14,6 @@ from vnrrt.evaluation.paper_comparison.report import (
     cell,
     networks_section,
 )
-from vnrrt.evaluation.config import StatsConfig
-from vnrrt.evaluation.paper_comparison.paper_noise import ratio_interval
 from vnrrt.evaluation.paper_comparison.summary import analyze
 from vnrrt.evaluation.paper_tables import load_paper_tables
 from vnrrt.evaluation.table import COLUMNS, conform

@@ -7,6 +7,7 @@ import time
 import numpy as np
 import pytest
 
+from vnrrt.data.heatmaps import HeatmapError
 from vnrrt.data.instances import EvalInstance
 from vnrrt.evaluation import trials as trials_module
 from vnrrt.evaluation.keys import ConfigKey
@@ -102,7 +103,7 @@ def test_a_budget_hit_is_a_failed_row_not_a_crash():
 
 def test_missing_heatmap_is_a_clear_error():
     bare = dataclasses.replace(wall_instance(), heatmaps={})
-    with pytest.raises(KeyError, match="no 'path' heatmap"):
+    with pytest.raises(HeatmapError, match="no 'path' heatmap"):
         run_trials([bare], SPECS, {("named", "initial"): 1})
 
 

@@ -10,7 +10,13 @@ from hydra.utils import instantiate
 
 from tests.train_helpers import QUICK, paths, small_cfg
 from vnrrt.config import compose
-from vnrrt.model.checkpoint import CheckpointError, checksum_file, load_network, read_checkpoint
+from vnrrt.model.checkpoint import (
+    CheckpointError,
+    checksum_file,
+    load_network,
+    read_checkpoint,
+    seal,
+)
 from vnrrt.model.metrics import VertexRecall
 from vnrrt.training.callbacks import LogProgress
 from vnrrt.training.stage import run_train as train
@@ -145,7 +151,7 @@ def test_loading_checks_the_network_and_the_weights(trained, tmp_path):
         load_network(trained / "models" / "nrrtnet.ckpt", "vertexnet")
     ckpt = read_checkpoint(trained / "models" / "vertexnet.ckpt")
     del ckpt["state_dict"]["net.head.bias"]
-    torch.save(ckpt, tmp_path / "cut.ckpt")
+    torch.save(seal(ckpt), tmp_path / "cut.ckpt")  # a digest that matches: only the fit fails
     with pytest.raises(CheckpointError, match=r"cut\.ckpt does not fit the network: missing: "
                                               r"head\.bias"):  # fmt: skip
         load_network(tmp_path / "cut.ckpt")

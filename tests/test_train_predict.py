@@ -118,6 +118,10 @@ def test_bad_parts_and_missing_heatmaps_are_named(predicted, tmp_path):
     (tmp_path / "bad.npz").write_bytes(b"not a zip")
     with pytest.raises(HeatmapError, match="bad.npz is not a readable"):
         read_heatmaps(tmp_path / "bad.npz")
+    whole = part_file(cfg.paths.heatmaps, 0).read_bytes()
+    (tmp_path / "cut.npz").write_bytes(whole[: len(whole) // 2])  # an interrupted copy
+    with pytest.raises(HeatmapError, match="cut.npz is not a readable .npz: File is not a zip"):
+        read_heatmaps(tmp_path / "cut.npz")
 
 
 def test_the_command_line_predicts_what_the_stage_predicted(predicted, tmp_path, capsys):
@@ -155,3 +159,60 @@ def test_the_command_line_predicts_what_the_stage_predicted(predicted, tmp_path,
     other = int(np.flatnonzero(~(read_heatmaps(right)["keys"] == (-1, 2)).all(axis=1))[0])
     assert main([*plan, str(right), "--row", str(other)]) == 2
     assert "not the --map instance (-1, 2)" in capsys.readouterr().err
+
+
+def _named_2(cfg):
+    """The named-maps file, instance 2 of it (as the CLI reads it) and the heatmap part
+    holding that instance."""
+    from vnrrt.cli import load_instance
+
+    files = [part_file(cfg.paths.heatmaps, k) for k in cfg.predict.parts]
+    right = next(f for f in files if ((read_heatmaps(f)["keys"] == (-1, 2)).all(axis=1)).any())
+    return str(cfg.paths.named_maps), load_instance(Path(cfg.paths.named_maps), "2"), right
+
+
+def test_a_pipeline_heatmap_is_refused_for_endpoints_it_was_not_made_for(predicted, capsys):
+    """A pipeline heatmap is its instance's, for that instance's own start and goal:
+    --start/--goal that move them get a heatmap of other endpoints, which is refused."""
+    from vnrrt.cli import main
+
+    named, inst, right = _named_2(predicted[0])
+    heat = ["plan", "--map", named, "--instance", "2", "--heatmap", str(right), "--network",
+            "vertexnet", "--planner", "vnrrt_star"]  # fmt: skip
+    swapped = ["--start", "{},{}".format(*inst["goal"]), "--goal", "{},{}".format(*inst["start"])]
+    assert main([*heat, *swapped]) == 2
+    err = capsys.readouterr().err
+    assert "--start/--goal move them: predict one with --checkpoint" in err
+    assert err.count("\n") == 1
+    same_cells = ["--start", "{},{}".format(*(np.floor(inst["start"]) + 0.25))]
+    assert main([*heat, *same_cells]) == 0  # another point of the same start cell: same input
+
+
+def test_a_network_of_another_target_than_the_planner_samples_is_refused(predicted, capsys):
+    """VNRRT* and M-VNRRT* sample vertex heatmaps, NRRT* path heatmaps: the command line
+    refuses a checkpoint or a pipeline heatmap of the other network, naming both, and
+    vnrrt.predict does given a target."""
+    from vnrrt.cli import main
+    from vnrrt.model.checkpoint import CheckpointError
+
+    cfg, _, _ = predicted
+    named, inst, right = _named_2(cfg)
+    models = Path(cfg.paths.models)
+    base = ["plan", "--map", named, "--instance", "2"]
+    heat = [*base, "--heatmap", str(right), "--planner", "nrrt_star", "--network"]
+    assert main([*heat, "vertexnet"]) == 2
+    err = capsys.readouterr().err
+    assert (f"network vertexnet of {right} predicts vertex heatmaps, not the path heatmaps that "
+            "--planner nrrt_star samples") in err and err.count("\n") == 1  # fmt: skip
+    assert main([*heat, "nrrtnet"]) == 0  # its own network
+    capsys.readouterr()
+    ckpt = str(models / "nrrtnet.ckpt")
+    for planner, extra in (("vnrrt_star", []), ("m_vnrrt_star", ["--tau", "0.5"])):
+        assert main([*base, "--planner", planner, "--checkpoint", ckpt, *extra]) == 2
+        assert (f"network {ckpt} predicts path heatmaps, not the vertex heatmaps that --planner "
+                f"{planner} samples") in capsys.readouterr().err  # fmt: skip
+    grid = inst["grid"]
+    start, goal = (tuple(int(v) for v in inst[k]) for k in ("start", "goal"))  # their cells
+    with pytest.raises(CheckpointError, match="predicts path heatmaps, not the vertex"):
+        heatmap(models / "nrrtnet.ckpt", grid, start, goal, target="vertex")
+    assert heatmap(models / "nrrtnet.ckpt", grid, start, goal, target="path").shape == grid.shape

@@ -1,11 +1,22 @@
 """MLflow tracking: the default SQLite store, artifact roots that follow the repository, tags,
-and what a training run records (an MLflow Model that predicts what the checkpoint does)."""
+what a training run records (an MLflow Model that predicts what the checkpoint does), and the
+services: an unreachable server refused at once, a locked SQLite store waited for, runs of a
+killed stage (and only those) closed at the next start."""
 
+import http.server
 import os
 import shutil
+import socket
+import sqlite3
+import subprocess
+import sys
+import threading
+import time
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
+import pytest
 from mlflow import MlflowClient
 
 from tests.train_helpers import small_cfg
@@ -123,7 +134,7 @@ def test_a_training_run_is_recorded_in_mlflow(small_data, tmp_path, monkeypatch)
     inst = shard.instance(0)
     grid = shard.grid(inst["map_index"])
     from_ckpt = heatmap(tmp_path / "models" / "vertexnet.ckpt", grid, inst["start"], inst["goal"])
-    from vnrrt.model.checkpoint import load_network
+    from vnrrt.model.checkpoint import CheckpointError, load_network
     from vnrrt.predict.api import Model, load_model
 
     from_mlflow = heatmap(Model(model.eval(), {}), grid, inst["start"], inst["goal"])
@@ -133,7 +144,155 @@ def test_a_training_run_is_recorded_in_mlflow(small_data, tmp_path, monkeypatch)
     for uri in (f"runs:/{run.info.run_id}/model", "models:/vnrrt-vertexnet/1"):
         loaded = load_model(uri)
         assert loaded.render == load_network(tmp_path / "models" / "vertexnet.ckpt")[1]["render"]
+        assert loaded.record["target"]["kind"] == "vertex"  # logged: checked for a planner
+        with pytest.raises(CheckpointError, match=f"network {uri} predicts vertex heatmaps, not "
+                                                  "the path heatmaps"):  # fmt: skip
+            heatmap(uri, grid, inst["start"], inst["goal"], target="path")
         np.testing.assert_allclose(
             heatmap(uri, grid, inst["start"], inst["goal"]), from_ckpt, atol=1e-6
         )
     assert not (tmp_path / "models" / "checkpoints" / "vertexnet").exists()  # cleaned up
+
+
+def closed_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def test_an_unreachable_tracking_server_fails_at_once_before_any_work(small_data, tmp_path):
+    """No minutes of MLflow's retries: the stage checks the server first (a refused
+    connection here) and stops with one line naming it, before writing anything."""
+    uri = f"http://127.0.0.1:{closed_port()}"
+    cfg = small_cfg(small_data, tmp_path, "logger.enabled=true", f"logger.uri={uri}")
+    with pytest.raises(ValueError, match=f"tracking server {uri} does not answer"):
+        run_train(cfg, "vertexnet")
+    assert not (tmp_path / "models").exists() and not (tmp_path / "metrics").exists()
+
+
+class Health(http.server.BaseHTTPRequestHandler):
+    status = 200
+
+    def do_GET(self):
+        self.send_response(self.status if self.path == "/health" else 404)
+        self.end_headers()
+
+    def log_message(self, *args):
+        pass
+
+
+@pytest.mark.parametrize("status", [200, 401, 503])
+def test_the_server_check_passes_an_answering_server_and_refuses_a_failing_one(status):
+    handler = type("H", (Health,), {"status": status})
+    server = http.server.ThreadingHTTPServer(("127.0.0.1", 0), handler)
+    threading.Thread(target=server.serve_forever, daemon=True).start()
+    uri = f"http://127.0.0.1:{server.server_address[1]}"
+    try:
+        if status < 500:  # up (401: behind authentication, still reachable)
+            tracking.check_store(uri)
+        else:
+            with pytest.raises(tracking.TrackingError, match="answers HTTP 503"):
+                tracking.check_store(uri)
+    finally:
+        server.shutdown()
+
+
+def test_a_server_that_never_answers_is_given_up_after_the_check_timeout():
+    with socket.socket() as silent:  # accepts connections (backlog), never replies
+        silent.bind(("127.0.0.1", 0))
+        silent.listen(1)
+        uri = f"http://127.0.0.1:{silent.getsockname()[1]}"
+        with pytest.raises(tracking.TrackingError, match="does not answer .*timed out"):
+            tracking.check_store(uri, timeout=0.5)
+    tracking.check_store("sqlite:////nowhere/mlflow.db")  # local stores: nothing to check
+
+
+def test_a_stage_waits_out_seconds_of_sqlite_lock_contention(tmp_path):
+    """Another process holds the store locked for 7 s when a stage opens it (SQLite's and
+    MLflow's default waits are 5 s there): the stage waits and goes on. ~10 s: the lock
+    must outlast that 5 s default."""
+    uri = f"sqlite:///{tmp_path / 'mlflow.db'}"
+    want = tracking.experiment_id("vnrrt-lock", uri)
+    child = subprocess.Popen(
+        [sys.executable, "-c", "import sys, mlflow; from vnrrt import tracking; print('ready', "
+         "flush=True); sys.stdin.readline(); print(tracking.experiment_id('vnrrt-lock', "
+         f"{uri!r}))"],
+        stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+    )  # fmt: skip
+    assert child.stdout.readline().strip() == "ready"
+    lock = sqlite3.connect(tmp_path / "mlflow.db", isolation_level=None)
+    lock.execute("BEGIN EXCLUSIVE")
+    child.stdin.write("go\n")
+    child.stdin.flush()
+    time.sleep(7.0)
+    lock.execute("COMMIT")
+    lock.close()
+    out, err = child.communicate(timeout=60)
+    assert child.returncode == 0, err[-2000:]
+    assert out.strip() == want
+
+
+def dead_pid() -> str:
+    """The id of a process that has ended."""
+    return subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
+                          capture_output=True, text=True, check=True).stdout.strip()  # fmt: skip
+
+
+def test_only_runs_whose_process_is_gone_are_marked_killed(tmp_path):
+    """Two experiments running the same stage at once (`dvc queue start -j 2`) must not close
+    each other's runs: a run is stale only when its process, on this host, is gone."""
+    uri = f"sqlite:///{tmp_path / 'mlflow.db'}"
+    exp = tracking.experiment_id("vnrrt-smoke", uri)
+    client = MlflowClient(uri)
+    tags = tracking.run_tags("evaluation", "smoke")
+    alive = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"])
+    try:
+        extras = {
+            "killed": {"pid": dead_pid()},
+            "live": {"pid": str(alive.pid)},
+            "other_host": {"host": "elsewhere", "pid": dead_pid()},
+        }
+        runs = {
+            n: client.create_run(exp, tags={**tags, **e}).info.run_id for n, e in extras.items()
+        }
+        marked = tracking.mark_stale_runs(uri, exp, tags)
+    finally:
+        alive.kill()
+        alive.wait()
+    assert marked == [runs["killed"]]
+    status = {n: client.get_run(r).info.status for n, r in runs.items()}
+    assert status == {"killed": "KILLED", "live": "RUNNING", "other_host": "RUNNING"}
+
+
+def test_open_experiment_closes_a_killed_evaluation_and_its_nested_runs(tmp_path):
+    """What the evaluation's MLflow code calls first: store checked, experiment id, tags
+    with this process, and the runs of a killed run of the same stage marked KILLED."""
+    uri = f"sqlite:///{tmp_path / 'mlflow.db'}"
+    logger = SimpleNamespace(uri=uri, experiment="vnrrt-smoke", artifact_location=None)
+    exp = tracking.experiment_id("vnrrt-smoke", uri)
+    client = MlflowClient(uri)
+    old = {**tracking.run_tags("evaluation", "smoke"), "pid": dead_pid()}
+    parent = client.create_run(exp, tags=old).info.run_id
+    nested = client.create_run(exp, tags={**old, "planner": "rrt_star",
+                                          "mlflow.parentRunId": parent}).info.run_id  # fmt: skip
+    ideas = client.create_run(exp, tags={**old, "kind": "ideas"}).info.run_id  # another stage
+    got_uri, got_exp, tags = tracking.open_experiment(logger, "evaluation", "smoke")
+    assert (got_uri, got_exp) == (uri, exp) and tags["pid"] == str(os.getpid())
+    assert tags["host"] == socket.gethostname() and tags["kind"] == "evaluation"
+    status = {r: client.get_run(r).info.status for r in (parent, nested, ideas)}
+    assert status == {parent: "KILLED", nested: "KILLED", ideas: "RUNNING"}
+
+
+def test_an_mlflow_model_that_cannot_be_loaded_is_one_line_exit_2(tmp_path, monkeypatch,
+                                                                   capsys):  # fmt: skip
+    from vnrrt.cli import main
+
+    monkeypatch.setenv("MLFLOW_TRACKING_URI", f"sqlite:///{tmp_path / 'mlflow.db'}")
+    np.save(tmp_path / "map.npy", np.zeros((32, 32), np.uint8))
+    rc = main(["predict", "--checkpoint", "runs:/0123456789abcdef/model", "--map",
+               str(tmp_path / "map.npy"), "--start", "2.5,2.5", "--goal", "30.5,30.5",
+               "--out", str(tmp_path / "heat.npy")])  # fmt: skip
+    err = capsys.readouterr().err  # MLflow logs its creation of the new store first
+    assert rc == 2 and "Traceback" not in err
+    assert err.splitlines()[-1].startswith("vnrrt predict: error: model runs:/0123456789abcdef/"
+                                           "model cannot be loaded from sqlite:///")  # fmt: skip

@@ -7,14 +7,17 @@ with a trained network.
   vnrrt predict --checkpoint CKPT --map FILE [--instance NAME|I | --start X,Y --goal X,Y]
              --out heatmap.npy|heatmap.png
 
-Maps: .npy occupancy (H, W), nonzero = obstacle; .png floor map: a class map (values 0 free,
-1 obstacle, 2 start, 3 goal, with at least one start and one goal pixel), otherwise a
-grayscale image whose dark pixels (< 128) are obstacles; .npz: a dataset shard or the
-pipeline's named maps (with --instance, an index or a named map's name, e.g. u_trap).
-Points are continuous (x, y) pixels; the cells of class maps and shards give their centres.
+Maps: .npy occupancy (H, W), nonzero = obstacle; .npz: a dataset shard or the pipeline's
+named maps (with --instance, an index or a named map's name, e.g. u_trap); .png, read the
+same at any bit depth (8 or 16 bits, gray, RGB or palette): an opaque image whose values are
+all 0-3 is a class map (0 free, 1 obstacle, 2 start, 3 goal; a 0/1 occupancy image is one),
+any other a picture whose dark pixels (gray level below half of white, transparent pixels
+counting as white) are obstacles. Points are continuous (x, y) pixels; the cells of class
+maps and shards give their centres.
 Heatmaps: .npy (H, W), a grayscale .png scaled to [0, 1], or a pipeline heatmap file (.npz,
-with --instance and --network). Exit status: 0 success, 1 the planner stopped on a budget,
-2 bad input (one line on stderr, no traceback).
+with --instance and --network: it must be the heatmap of the --map instance and its own
+start and goal cells). A network (--checkpoint, or --network of a pipeline file) must have
+the target the planner samples: vertex for vnrrt_star and m_vnrrt_star, path for nrrt_star.
 """
 
 from __future__ import annotations
@@ -28,10 +31,10 @@ from pathlib import Path
 import numpy as np
 
 from vnrrt import __version__
+from vnrrt.cli_inputs import UsageError, check_planner_target, load_heatmap, load_instance
+from vnrrt.stage_cli import EXIT_BUDGET, EXIT_HELP, EXIT_OK, run_reporting
 
-
-class UsageError(ValueError):
-    """A command-line argument is wrong; the message names it."""
+__all__ = ["UsageError", "build_parser", "load_heatmap", "load_instance", "main"]
 
 
 def _point(text: str) -> tuple[float, float]:
@@ -42,121 +45,6 @@ def _point(text: str) -> tuple[float, float]:
     if not (math.isfinite(x) and math.isfinite(y)):
         raise argparse.ArgumentTypeError(f"expected finite X,Y, got {text!r}")
     return x, y
-
-
-def _read_image(path: Path) -> np.ndarray:
-    import cv2
-
-    img = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
-    if img is None:
-        raise UsageError(f"cannot read image {path}")
-    return img if img.ndim == 2 else cv2.cvtColor(img[..., :3], cv2.COLOR_BGR2GRAY)
-
-
-def _first_pixel(img: np.ndarray, value: int):
-    ys, xs = np.nonzero(img == value)
-    return (float(xs[0]) + 0.5, float(ys[0]) + 0.5) if len(xs) else None
-
-
-def _shard_instance(path: Path, instance: str | None) -> dict:
-    from vnrrt.data.reader import Shard
-
-    if instance is None:
-        raise UsageError(f"{path} holds many instances: give --instance (an index or a name)")
-    shard = Shard(path)
-    _verify_against_manifest(path)
-    names = list(shard.meta.get("names", []))
-    if instance in names:
-        index = names.index(instance)
-    elif instance.lstrip("-").isdigit():
-        index = int(instance)
-    else:
-        known = f"; names: {', '.join(names)}" if names else ""
-        raise UsageError(f"--instance {instance!r} is not an index of {path}{known}")
-    if not 0 <= index < shard.n_instances:
-        raise UsageError(f"--instance {index} not in [0, {shard.n_instances}) of {path}")
-    inst = shard.instance(index)
-    s, g = inst["start"], inst["goal"]
-    return {"grid": shard.grid(inst["map_index"]), "start": (s[0] + 0.5, s[1] + 0.5),
-            "goal": (g[0] + 0.5, g[1] + 0.5), "astar": inst["length"], "index": index,
-            "key": (int(shard.meta.get("shard", -1)), index)}  # fmt: skip
-
-
-def _verify_against_manifest(path: Path) -> None:
-    """A shard beside a pipeline manifest (``../manifest.json``) must match its checksum."""
-    from vnrrt.data.manifest import verify_manifest
-
-    manifest = path.parent.parent / "manifest.json"
-    if manifest.is_file() and path.parent.name == "shards":
-        listed = {p.resolve() for p in verify_manifest(manifest)}
-        if path.resolve() not in listed:
-            raise UsageError(f"{path} is not listed in {manifest}")
-
-
-def load_instance(path: Path, instance: str | None) -> dict:
-    """Grid ``(H, W)`` uint8 and, where the file holds them, start/goal points and the A*
-    length (formats in the module doc)."""
-    if not path.is_file():
-        raise UsageError(f"map file {path} not found")
-    if path.suffix == ".npz":
-        return _shard_instance(path, instance)
-    if instance is not None:
-        raise UsageError(f"--instance needs a shard or named-maps .npz, not {path.suffix}")
-    if path.suffix == ".npy":
-        return {"grid": np.load(path)}
-    if path.suffix == ".png":
-        img = _read_image(path)
-        start, goal = _first_pixel(img, 2), _first_pixel(img, 3)
-        if img.max() <= 3 and start is not None and goal is not None:
-            return {"grid": (img == 1).astype(np.uint8), "start": start, "goal": goal}
-        return {"grid": (img < 128).astype(np.uint8)}
-    raise UsageError(f"unsupported map file {path}: use .npy, .png or a shard .npz")
-
-
-def load_heatmap(
-    path: Path,
-    key: tuple[int, int] | None = None,
-    network: str | None = None,
-    row: int | None = None,
-) -> np.ndarray:
-    """Heatmap ``(H, W)`` float64 from ``.npy``, a grayscale ``.png`` (scaled to [0, 1]) or a
-    pipeline heatmap file (``.npz``: ``network``'s heatmap of the instance ``key`` = (shard
-    id, instance index; -1 for the named maps), or of ``row`` when the map has no key; both
-    given must agree, so that a heatmap of another instance is never used)."""
-    if not path.is_file():
-        raise UsageError(f"heatmap file {path} not found")
-    if path.suffix == ".npy":
-        return np.load(path).astype(np.float64)
-    if path.suffix == ".png":
-        img = _read_image(path)
-        return img.astype(np.float64) / float(np.iinfo(img.dtype).max)
-    if path.suffix == ".npz":
-        from vnrrt.data.heatmaps import read_heatmaps
-
-        heat = read_heatmaps(path)
-        nets = sorted(heat["maps"])
-        if network not in heat["maps"]:
-            raise UsageError(f"give --network, one of {nets} in {path}")
-        return heat["maps"][network][_heat_row(heat["keys"], path, key, row)].astype(np.float64)
-    raise UsageError(f"unsupported heatmap file {path}: use .npy, .png or a pipeline .npz")
-
-
-def _heat_row(keys: np.ndarray, path: Path, key, row: int | None) -> int:
-    """The row of a heatmap file's ``keys`` (N, 2) for instance ``key`` and/or ``row``."""
-    if row is not None and not 0 <= row < len(keys):
-        raise UsageError(f"--row {row} is not one of the {len(keys)} rows of {path}")
-    if key is None:
-        if row is None:
-            raise UsageError(f"give --row: which of the {len(keys)} heatmaps of {path}")
-        return row
-    hits = np.flatnonzero((keys == np.asarray(key)).all(axis=1))
-    if not len(hits):
-        raise UsageError(f"{path} holds no heatmap of instance {tuple(key)} (shard, index) of "
-                         "--map: use the heatmap file (part) that covers it")  # fmt: skip
-    if row is not None and row != hits[0]:
-        raise UsageError(f"--row {row} of {path} is instance {tuple(keys[row])}, not the "
-                         f"--map instance {tuple(key)} (row {hits[0]})")  # fmt: skip
-    return int(hits[0])
 
 
 def _overrides(pairs: list[str]) -> dict:
@@ -242,17 +130,27 @@ def add_plan_command(sub: argparse._SubParsersAction) -> None:
 
 
 def _heatmap(args, inst: dict, start, goal) -> np.ndarray | None:
+    """The heatmap of ``--checkpoint`` or ``--heatmap`` for these endpoints, or None."""
+    from vnrrt.grid import point_to_cell
+
     if args.heatmap and args.checkpoint:
         raise UsageError("give --heatmap or --checkpoint, not both")
+    cells = point_to_cell(np.array([start, goal]))
     if args.checkpoint:
-        from vnrrt.grid import point_to_cell
-        from vnrrt.predict import heatmap
+        from vnrrt.predict import heatmap, load_model
 
-        cells = point_to_cell(np.array([start, goal]))
-        return heatmap(args.checkpoint, inst["grid"], tuple(cells[0]), tuple(cells[1]))
-    if args.heatmap:
-        return load_heatmap(args.heatmap, inst.get("key"), args.network, args.row)
-    return None
+        model = load_model(args.checkpoint)
+        check_planner_target(model.record, args.planner, args.checkpoint)
+        return heatmap(model, inst["grid"], tuple(cells[0]), tuple(cells[1]))
+    if not args.heatmap:
+        return None
+    if args.heatmap.suffix == ".npz" and "key" in inst:
+        own = point_to_cell(np.array([inst["start"], inst["goal"]]))
+        if not np.array_equal(cells, own):
+            raise UsageError(f"--heatmap {args.heatmap} holds instance {inst['key']}'s heatmap "
+                             f"for start cell {tuple(own[0])} and goal cell {tuple(own[1])}; "
+                             "--start/--goal move them: predict one with --checkpoint")  # fmt: skip
+    return load_heatmap(args.heatmap, inst.get("key"), args.network, args.row, args.planner)
 
 
 def run_plan(args: argparse.Namespace) -> int:
@@ -286,7 +184,7 @@ def run_plan(args: argparse.Namespace) -> int:
 
         save_plan(args.out, inst["grid"], result, start, goal, heatmap)
         print(f"figure: {args.out}")
-    return 0 if result.success else 1
+    return EXIT_OK if result.success else EXIT_BUDGET
 
 
 def add_predict_command(sub: argparse._SubParsersAction) -> None:
@@ -336,7 +234,10 @@ COMMANDS: list[Callable[[argparse._SubParsersAction], None]] = [
 def build_parser() -> argparse.ArgumentParser:
     """The ``vnrrt`` parser with one sub-command per entry of :data:`COMMANDS`."""
     parser = argparse.ArgumentParser(
-        prog="vnrrt", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+        prog="vnrrt",
+        description=__doc__,
+        epilog=EXIT_HELP,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument("--version", action="version", version=f"vnrrt {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
@@ -347,14 +248,9 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``vnrrt`` console script and ``python -m vnrrt``; returns the exit
-    status (module doc)."""
+    status (:data:`vnrrt.stage_cli.EXIT_HELP`: 0 success, 1 budget, 2 bad input, 3 bug)."""
     args = build_parser().parse_args(argv)
-    try:
-        return args.func(args)
-    except (ValueError, FileNotFoundError, IsADirectoryError, PermissionError) as err:
-        message = str(err).splitlines()[0] if str(err) else type(err).__name__
-        print(f"vnrrt {args.command}: error: {message}", file=sys.stderr)
-        return 2
+    return run_reporting(f"vnrrt {args.command}", lambda: args.func(args))
 
 
 if __name__ == "__main__":

@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import io
 import json
+import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -78,8 +79,8 @@ def read_heatmaps(path: str | Path) -> dict:
     try:
         with np.load(path, allow_pickle=False) as npz:
             arrays = {k: npz[k] for k in npz.files}
-    except (OSError, ValueError) as err:
-        raise HeatmapError(f"heatmap file {path} is not a readable .npz: {err}") from err
+    except (OSError, ValueError, zipfile.BadZipFile, EOFError) as err:  # missing, cut, foreign
+        raise HeatmapError(f"heatmap file {path} is not a readable .npz: {err}") from None
     missing = [k for k in ("format_version", "meta", "keys") if k not in arrays]
     if missing or int(arrays["format_version"]) != FORMAT_VERSION:
         raise HeatmapError(f"heatmap file {path}: missing {missing} or not format {FORMAT_VERSION}")

@@ -43,6 +43,7 @@ from __future__ import annotations
 import dataclasses
 import functools
 import json
+import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -107,7 +108,7 @@ def _load(path: str, mtime: float) -> dict[str, np.ndarray]:
     try:
         with np.load(path, allow_pickle=False) as npz:
             arrays = {k: npz[k] for k in npz.files}
-    except (OSError, ValueError, EOFError) as err:
+    except (OSError, ValueError, EOFError, zipfile.BadZipFile) as err:
         raise InstancesError(f"instances file {path} is unreadable: {err}") from None
     if int(arrays.get("format_version", -1)) != FORMAT_VERSION:
         raise InstancesError(f"instances file {path} is not format {FORMAT_VERSION}")

@@ -19,6 +19,9 @@ import numpy as np
 from vnrrt.grid import disk
 
 TARGETS = ("vertex", "path")
+# The target whose heatmap each heatmap planner samples (paper): VertexNet's vertices for
+# VNRRT* and M-VNRRT*, the NRRT* network's path cells for NRRT*.
+PLANNER_TARGETS = {"nrrt_star": "path", "vnrrt_star": "vertex", "m_vnrrt_star": "vertex"}
 ENDPOINTS = ("both", "goal", "none")
 
 

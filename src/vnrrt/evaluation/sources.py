@@ -33,6 +33,7 @@ import math
 import cv2
 import numpy as np
 
+from vnrrt.data.heatmaps import HeatmapError
 from vnrrt.grid import as_cell, as_occupancy, cell_center
 from vnrrt.search import any_angle_path, astar, path_vertices
 
@@ -233,7 +234,7 @@ def source_heatmap(source: str, inst, sigma: float | None, floor: float | None) 
             raise ValueError(f"oracle source {source!r} needs oracle.sigma and oracle.floor")
         return instance_heatmap(source, inst, sigma, floor)
     known = sorted(inst.heatmaps)
-    raise KeyError(f"instance {inst.map} has no {source!r} heatmap (known: {known})")
+    raise HeatmapError(f"instance {inst.map} has no {source!r} heatmap (known: {known})")
 
 
 def source_target(source: str, network_targets: dict[str, str]) -> str:

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from vnrrt.data.heatmaps import HeatmapError
 from vnrrt.data.instances import EvalInstance
 from vnrrt.evaluation import sources
 from vnrrt.evaluation.keys import ConfigKey
@@ -129,7 +130,7 @@ def _needed(job: TrialJob, inst: EvalInstance) -> tuple[TrialJob, EvalInstance]:
     src = job.key.source
     if src is not None and not sources.is_oracle(src) and src not in inst.heatmaps:
         known = sorted(inst.heatmaps)
-        raise KeyError(f"instance {inst.map} has no {src!r} heatmap (known: {known})")
+        raise HeatmapError(f"instance {inst.map} has no {src!r} heatmap (known: {known})")
     keep = {src: inst.heatmaps[src]} if src in inst.heatmaps else {}
     return job, dataclasses.replace(inst, heatmaps=keep)
 

@@ -8,8 +8,10 @@ serves train, val and test; each split has its own metric collection
 
 from __future__ import annotations
 
+import hashlib
 import inspect
-from collections.abc import Callable
+import json
+from collections.abc import Callable, Mapping
 from typing import Any
 
 import lightning as L
@@ -20,6 +22,21 @@ from vnrrt.model.metrics import LABEL_MASKS, metric_collection
 
 SPLITS = ("train", "val", "test")
 RECORD_KEY = "vnrrt"  # checkpoint entry holding the run's record (network config, target, ...)
+DIGEST_KEY = "sha256"  # record entry: sha256 of the rest of the record and of the state dict
+
+
+def record_digest(record: Mapping[str, Any], state_dict: Mapping[str, Tensor]) -> str:
+    """sha256 (hex) of a checkpoint's content: its record (canonical JSON, the
+    :data:`DIGEST_KEY` entry left out) and every tensor of its state dict (name, dtype,
+    shape and raw bytes, in name order). A changed weight or record value changes it."""
+    h = hashlib.sha256()
+    rest = {k: v for k, v in record.items() if k != DIGEST_KEY}
+    h.update(json.dumps(rest, sort_keys=True, separators=(",", ":"), default=repr).encode())
+    for name in sorted(state_dict):
+        t = state_dict[name].detach().cpu().contiguous().reshape(-1)
+        h.update(f"\0{name}\0{t.dtype}\0{tuple(state_dict[name].shape)}\0".encode())
+        h.update(t.view(torch.uint8).numpy())  # the raw bytes, no copy
+    return h.hexdigest()
 
 
 class VertexNetModule(L.LightningModule):
@@ -121,4 +138,9 @@ class VertexNetModule(L.LightningModule):
         }
 
     def on_save_checkpoint(self, checkpoint: dict[str, Any]) -> None:
-        checkpoint[RECORD_KEY] = self.record
+        """Store the record, sealed with :func:`record_digest` of the weights being saved."""
+        record = {k: v for k, v in self.record.items() if k != DIGEST_KEY}
+        checkpoint[RECORD_KEY] = {
+            **record,
+            DIGEST_KEY: record_digest(record, checkpoint["state_dict"]),
+        }

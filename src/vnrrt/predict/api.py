@@ -3,7 +3,13 @@
 A network comes from a vnrrt checkpoint (``models/<scale>/vertexnet.ckpt``), from an MLflow
 model URI (``runs:/<run id>/model``, ``models:/vnrrt-vertexnet/1``) or is given as a loaded
 :class:`~vnrrt.predict.api.Model`. The input image is rendered exactly as in training (the
-checkpoint's record: start/goal marker radius, normalisation).
+checkpoint's record: start/goal marker radius, normalisation). ``target`` asks for a network
+trained on one target (``vnrrt.data.targets.PLANNER_TARGETS``: the one each planner samples);
+a network of another target is refused. Every loading problem raises
+:class:`~vnrrt.model.checkpoint.CheckpointError`.
+
+An MLflow model is a pickle (``serialization_format="pickle"``): load models only from a
+tracking store you trust. Checkpoint files are safe to load (:mod:`vnrrt.model.checkpoint`).
 """
 
 from __future__ import annotations
@@ -36,21 +42,28 @@ class Model:
 
 
 def _from_mlflow(uri: str) -> Model:
-    try:
-        import mlflow.pytorch
-    except ImportError as err:  # pragma: no cover - mlflow is a dependency of the pipeline
-        raise ValueError(f"loading {uri!r} needs mlflow installed") from err
     import mlflow
+    import mlflow.pytorch
 
     from vnrrt import tracking
+    from vnrrt.model.checkpoint import CheckpointError
 
-    mlflow.set_tracking_uri(tracking.tracking_uri())
-    net = mlflow.pytorch.load_model(uri, map_location="cpu")
+    store = tracking.tracking_uri()
+    tracking.check_store(store)
+    mlflow.set_tracking_uri(store)
+    try:
+        net = mlflow.pytorch.load_model(uri, map_location="cpu")
+        meta = mlflow.models.get_model_info(uri).metadata or {}
+    except Exception as err:  # MlflowException, OSError, unpickling errors
+        text = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
+        raise CheckpointError(f"model {uri} cannot be loaded from {store}: {text}") from None
     if not isinstance(net, torch.nn.Module):  # a torch.export program (pt2 format)
         net = net.module()
-    # the input rendering the network was trained with (logged as model metadata)
-    render = (mlflow.models.get_model_info(uri).metadata or {}).get("render", DEFAULT_RENDER)
-    return Model(net.eval(), {"render": dict(render), "source": uri})
+    # the input rendering and target the network was trained with (logged as model metadata)
+    record = {"render": dict(meta.get("render", DEFAULT_RENDER)), "source": uri}
+    if "target" in meta:
+        record["target"] = dict(meta["target"])
+    return Model(net.eval(), record)
 
 
 @functools.lru_cache(maxsize=8)
@@ -81,7 +94,12 @@ def load_model(source: str | Path | Model) -> Model:
 
 @torch.inference_mode()
 def heatmap(
-    model: str | Path | Model, grid: np.ndarray, start, goal, device: str | torch.device = "cpu"
+    model: str | Path | Model,
+    grid: np.ndarray,
+    start,
+    goal,
+    device: str | torch.device = "cpu",
+    target: str | None = None,
 ) -> np.ndarray:
     """The network's probability of its positive class (vertex, or path cell) per pixel.
 
@@ -90,11 +108,18 @@ def heatmap(
         grid: ``(H, W)`` occupancy (nonzero = obstacle), indexed ``grid[y, x]``.
         start, goal: integer cells ``(x, y)`` in free space (the instance's endpoints).
         device: where to run the network (``"cpu"`` by default).
+        target: ``"vertex"`` or ``"path"``: refuse a network trained on the other target
+            (or recording none); ``PLANNER_TARGETS[planner]`` for a planner's heatmap
+            (:mod:`vnrrt.data.targets`).
 
     Returns:
         ``(H, W)`` float32 in [0, 1], indexed like ``grid``.
     """
     m = load_model(model)
+    if target is not None:
+        from vnrrt.model.checkpoint import require_target
+
+        require_target(m.record, target, str(m.record.get("source") or model))
     occ = as_occupancy(grid)
     s, g = as_cell(occ, start, "start"), as_cell(occ, goal, "goal")
     image = render_instance(occ, s, g, **m.render)  # (3, H, W)
@@ -103,4 +128,7 @@ def heatmap(
     autocast = torch.autocast("cuda", torch.bfloat16) if x.device.type == "cuda" else None
     with autocast or contextlib.nullcontext():
         probs = net(x).float().softmax(dim=1)[0, 1]  # (H, W)
-    return probs.cpu().numpy().astype(np.float32)
+    out = probs.cpu().numpy().astype(np.float32)
+    if not np.isfinite(out).all():
+        raise ValueError(f"network {model} gave non-finite probabilities for this instance")
+    return out

@@ -27,7 +27,7 @@ from pathlib import Path
 from omegaconf import DictConfig, OmegaConf
 
 from vnrrt import tracking
-from vnrrt.config import section
+from vnrrt.config import ConfigError, section
 from vnrrt.paths import Paths
 
 log = logging.getLogger(__name__)
@@ -54,9 +54,9 @@ def _plain(node):
 
 
 def network_spec(cfg: DictConfig, network: str) -> NetworkSpec:
-    """``networks.<network>`` typed; ``KeyError`` lists the known ones."""
+    """``networks.<network>`` typed; ``ConfigError`` lists the known ones."""
     if network not in cfg.networks:
-        raise KeyError(f"unknown network {network!r}; configured: {sorted(cfg.networks)}")
+        raise ConfigError(f"unknown network {network!r}; configured: {sorted(cfg.networks)}")
     return section(cfg.networks, network, NetworkSpec)
 
 
@@ -147,10 +147,9 @@ def make_logger(logger_cfg: tracking.LoggerConfig, scale: str, network: str, rec
     params, the run's whole config (``config_text``) as ``config.yaml``."""
     from hydra.utils import instantiate
 
-    uri = tracking.tracking_uri(logger_cfg.uri)
-    exp = tracking.experiment_id(logger_cfg.experiment, uri, logger_cfg.artifact_location)
-    tags = tracking.run_tags(network, scale, fingerprint=record["fingerprint"])
-    tracking.mark_stale_runs(uri, exp, tags)
+    uri, _, tags = tracking.open_experiment(
+        logger_cfg, network, scale, fingerprint=record["fingerprint"]
+    )
     logger = instantiate(
         logger_cfg.lightning, run_name=f"{network} {scale}", tracking_uri=uri, tags=tags
     )
@@ -187,7 +186,9 @@ def run_train(cfg: DictConfig, network: str) -> dict:
     """Stage ``train@<network>``: train ``network`` as configured (module doc); returns and
     writes its metrics. The stage's parameters are read here; below, typed pieces."""
     logger_cfg = section(cfg, "logger", tracking.LoggerConfig)
-    tracking.configure(logger_cfg.uri)  # before Lightning (and its MLflow logger) is imported
+    uri = tracking.configure(logger_cfg.uri)  # before Lightning (and its MLflow logger) imports
+    if logger_cfg.enabled:
+        tracking.check_store(uri)  # an unreachable server fails here, before any work
     import lightning as L
     from hydra.utils import instantiate
 
@@ -273,5 +274,6 @@ def log_model(logger_cfg: tracking.LoggerConfig, network: str, checkpoint: Path,
             input_example=example,
             registered_model_name=registered,
             serialization_format="pickle",
-            metadata={"render": dict(record["render"])},  # how to draw its input image
+            # how to draw its input image, and what it predicts (checked by vnrrt.predict)
+            metadata={"render": dict(record["render"]), "target": dict(record["target"])},
         )

@@ -39,10 +39,10 @@ def log_evaluation(
     parent's id."""
     import mlflow
 
-    uri = tracking.tracking_uri(logger.uri)
+    uri, exp, tags = tracking.open_experiment(
+        logger, "evaluation", scale, **training_tags(trainings)
+    )
     mlflow.set_tracking_uri(uri)
-    exp = tracking.experiment_id(logger.experiment, uri, logger.artifact_location)
-    tags = tracking.run_tags("evaluation", scale, **training_tags(trainings))
     with mlflow.start_run(experiment_id=exp, run_name=f"evaluation {scale}", tags=tags) as parent:
         mlflow.log_params(tracking.flat_params(params))
         mlflow.log_metrics(tracking.flat_metrics(headline_metrics))

@@ -94,6 +94,7 @@ def report_settings(cfg: DictConfig) -> dict:
 
 def run_report(cfg: DictConfig) -> Path:
     """Stage ``report`` (module doc); returns the report's path."""
+    from vnrrt import tracking
     from vnrrt.data.instances import Instances
     from vnrrt.evaluation.config import mask_taus
     from vnrrt.evaluation.paper_comparison.report import (
@@ -108,6 +109,8 @@ def run_report(cfg: DictConfig) -> Path:
 
     s = report_settings(cfg)
     paths, ev, planner, logger, scale = s["paths"], s["eval"], s["planner"], s["logger"], s["scale"]
+    if logger.enabled:  # an unreachable store fails here, before any work
+        tracking.check_store(tracking.tracking_uri(logger.uri))
     keys = configurations(ev, mask_taus(planner.taus, planner.tau), planner.tau)
     summary, predict = read_json(paths.summary), read_json(paths.predict_metrics)
     networks = predict["networks"]

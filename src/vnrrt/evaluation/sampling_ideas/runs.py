@@ -17,10 +17,8 @@ def log_ideas(
     nested); returns the parent's id."""
     import mlflow
 
-    uri = tracking.tracking_uri(logger.uri)
+    uri, exp, tags = tracking.open_experiment(logger, "ideas", scale)
     mlflow.set_tracking_uri(uri)
-    exp = tracking.experiment_id(logger.experiment, uri, logger.artifact_location)
-    tags = tracking.run_tags("ideas", scale)
     with mlflow.start_run(experiment_id=exp, run_name=f"ideas {scale}", tags=tags) as parent:
         mlflow.log_params(tracking.flat_params(params))
         for key in sorted({k for per in summary["oracle"].values() for k in per}):

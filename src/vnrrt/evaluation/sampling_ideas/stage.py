@@ -153,6 +153,7 @@ def run_ideas(cfg: DictConfig) -> dict:
     """Stage ``ideas`` (module doc); returns the summary."""
     import os
 
+    from vnrrt import tracking
     from vnrrt.evaluation.paper_tables import claim_pairs, load_paper_tables
     from vnrrt.evaluation.protocol import configurations
     from vnrrt.evaluation.sampling_ideas.report import build_ideas_report
@@ -162,6 +163,8 @@ def run_ideas(cfg: DictConfig) -> dict:
 
     settings = ideas_settings(cfg)
     rules, st, logger = settings["planner"], settings["stats"], settings["logger"]
+    if logger.enabled:  # an unreachable store fails here, before any work
+        tracking.check_store(tracking.tracking_uri(logger.uri))
     s, scale = _study(settings), settings["scale"]["name"]
     tables = {}
     for which in ("oracle", "regime"):

@@ -1,0 +1,86 @@
+"""Exit statuses of the DVC stage scripts: bad configuration or input is status 2 with one
+line on stderr, an internal error status 3 with its traceback; ``--help`` lists them."""
+
+import subprocess
+import sys
+
+import pytest
+
+from tests.conftest import copy_pipeline
+from vnrrt.config import compose, dump
+
+
+@pytest.fixture(scope="module")
+def work(repo, tmp_path_factory):
+    """A copy of the pipeline (dvc.yaml, stages, conf) with the default parameters."""
+    dest = copy_pipeline(repo, tmp_path_factory.mktemp("stages"))
+    (dest / "params.yaml").write_text(dump(compose([])))
+    return dest
+
+
+def run_stage(work, *args):
+    return subprocess.run([sys.executable, *args], cwd=work, capture_output=True, text=True,
+                          timeout=120)  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    ("setup", "message"),
+    [
+        (["planner.eta=-1"], "eta=-1.0: must be > 0"),
+        (None, "nothing.yaml"),
+    ],
+)
+def test_bad_params_exit_2_with_one_line(work, tmp_path, setup, message):
+    """An invalid value, or a parameters file that does not exist: one line naming it."""
+    params = tmp_path / ("params.yaml" if setup else "nothing.yaml")
+    if setup:
+        params.write_text(dump(compose(setup)))
+    out = run_stage(work, "stages/validate.py", "--params", str(params))
+    assert out.returncode == 2, out.stderr
+    assert message in out.stderr and out.stderr.count("\n") == 1, out.stderr
+    assert "Traceback" not in out.stderr and out.stderr.startswith("stage validate: error: ")
+
+
+def test_a_stage_that_succeeds_exits_0(work):
+    out = run_stage(work, "stages/validate.py")
+    assert out.returncode == 0, out.stderr
+
+
+def test_an_internal_error_of_a_stage_exits_3_with_its_traceback(work):
+    script = work / "stages" / "broken.py"
+    script.write_text(
+        "from vnrrt.stage_cli import stage_main\n\n"
+        "def broken(cfg):\n    raise RuntimeError('boom')\n\n"
+        "stage_main('validate', broken, 'a stage with a bug')\n"
+    )
+    out = run_stage(work, "stages/broken.py")
+    assert out.returncode == 3, out.stderr
+    last = out.stderr.strip().splitlines()[-1]
+    assert "Traceback" in out.stderr and "raise RuntimeError('boom')" in out.stderr
+    assert last.startswith("stage validate: internal error (RuntimeError: boom)")
+
+
+def test_stage_help_lists_the_exit_statuses(work):
+    out = run_stage(work, "stages/train.py", "--help")
+    flat = " ".join(out.stdout.split())
+    assert out.returncode == 0 and "2 bad configuration" in flat and "3 an internal error" in flat
+
+
+def test_errors_are_classed_as_input_or_internal(capsys):
+    import zipfile
+
+    from mlflow.exceptions import MlflowException
+
+    from vnrrt.stage_cli import EXIT_INPUT, is_input_error, run_reporting
+
+    for err in (ValueError("x"), FileNotFoundError("x"), zipfile.BadZipFile("x"),
+                MlflowException("store down")):  # fmt: skip
+        assert is_input_error(err), err
+    for err in (RuntimeError("x"), KeyError("x"), TypeError("x"), AssertionError()):
+        assert not is_input_error(err), err
+
+    def bad_input() -> int:
+        raise ValueError("first line\nsecond line")
+
+    assert run_reporting("prog", bad_input) == EXIT_INPUT
+    assert capsys.readouterr().err == "prog: error: first line\n"
