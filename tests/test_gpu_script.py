@@ -222,6 +222,15 @@ def test_a_returned_folder_needs_its_metrics(returned, bundle, tmp_path):
     assert read_returned(out / "heatmaps", bundle / "instances.npz")["metrics"] is None
 
 
+def test_the_reader_refuses_heatmaps_of_another_instances_file(returned, bundle, tmp_path):
+    with np.load(bundle / "instances.npz") as npz:
+        arrays = {k: npz[k] for k in npz.files}
+    arrays["exact_length"] = arrays["exact_length"] + 1.0  # same keys, other content
+    np.savez_compressed(tmp_path / "instances.npz", **arrays)
+    with pytest.raises(ReturnedError, match="predicted another instances file"):
+        read_returned(returned, tmp_path / "instances.npz")
+
+
 @pytest.mark.parametrize(
     ("args", "message"),
     [

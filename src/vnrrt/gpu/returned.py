@@ -29,6 +29,7 @@ import numpy as np
 
 from vnrrt.data.heatmaps import HeatmapError, part_file, part_rows, read_heatmaps, write_heatmaps
 from vnrrt.evaluation.instances import Instances  # the one import of the instances format
+from vnrrt.io import sha256
 
 MAX_FILES, MAX_DEPTH = 8, 2
 MAX_FILE_BYTES, MAX_TOTAL_BYTES = 16 << 20, 64 << 20
@@ -40,7 +41,8 @@ HEATMAPS_DIR = "heatmaps"
 NETWORK_META = ("target", "checkpoint_sha256", "images_seen", "train_images_per_s",
                 "infer_images_per_s", "batch_size")  # fmt: skip
 RUN_META = ("machine", "budget_s", "networks", "part", "parts")
-METRICS_FIELDS = ("machine", "budget_s", "elapsed_s", "phases", "data", "probe", "networks")
+METRICS_FIELDS = ("machine", "budget_s", "elapsed_s", "phases", "data", "probe", "networks",
+                  "source")  # fmt: skip
 _NAME = re.compile(r"^[A-Za-z0-9._-]+$")
 
 
@@ -149,8 +151,8 @@ def read_returned(path: str | Path, instances: Instances | str | Path) -> dict:
 
     Returns :func:`vnrrt.data.heatmaps.read_parts`'s dict (``keys`` (N, 2), ``maps``
     {network: (N, S, S) float16}, ``meta`` one dict per part, ``counts``) plus ``metrics``
-    (``metrics.json`` of a returned folder, which must be there; None for a heatmaps folder
-    or file). :class:`ReturnedError` (or
+    (``metrics.json`` of a returned folder, which must be there and name the sha256 of
+    ``instances``' file; None for a heatmaps folder or file). :class:`ReturnedError` (or
     :class:`~vnrrt.data.heatmaps.HeatmapError`) in one line naming what is wrong: limits,
     format, keys not those of the instances in order, shapes, dtype, values, meta fields.
     """
@@ -171,7 +173,7 @@ def read_returned(path: str | Path, instances: Instances | str | Path) -> dict:
                                 f"{f['meta']['parts']}, found {len(files)} parts")  # fmt: skip
         _check_maps(f["maps"], len(f["keys"]), inst.size, where)
     returned = path.is_dir() and (path / HEATMAPS_DIR).is_dir()  # the whole output folder
-    metrics = _read_metrics(path / "metrics.json") if returned else None
+    metrics = _read_metrics(path / "metrics.json", inst) if returned else None
     return {
         "keys": keys,
         "maps": {n: np.concatenate([f["maps"][n] for f in files]) for n in NETWORKS},
@@ -181,7 +183,8 @@ def read_returned(path: str | Path, instances: Instances | str | Path) -> dict:
     }
 
 
-def _read_metrics(path: Path) -> dict:
+def _read_metrics(path: Path, inst: Instances) -> dict:
+    """The run's metrics; the instances file it predicted must be ``inst``'s (sha256)."""
     if not path.is_file():
         raise ReturnedError(f"{path} is missing: the run did not finish")
     try:
@@ -191,6 +194,9 @@ def _read_metrics(path: Path) -> dict:
     missing = [k for k in METRICS_FIELDS if k not in doc]
     if missing:
         raise ReturnedError(f"{path} lacks {missing}")
+    if doc["source"].get("instances_sha256") != sha256(inst.path):
+        raise ReturnedError(f"{path}: the run predicted another instances file than "
+                            f"{inst.path} (sha256 differs)")  # fmt: skip
     return doc
 
 

@@ -127,6 +127,7 @@ def decide_compile(plan: RunPlan, make, dataset, device, precision: str, probe: 
 def run_probes(plan: RunPlan, cfg: dict, clock: Clock, n_shards: int, device) -> dict:
     """Batch, loader and compile probes (probe share); ``planned_images_per_s``."""
     tick = time.perf_counter()
+    torch_flags(cfg["trainer"])
     workers = _workers(plan, cfg)
     dm = make_datamodule(cfg, plan.work, n_shards, "vertexnet", plan.min_batch, workers,
                          device.type == "cuda")  # fmt: skip
@@ -143,6 +144,15 @@ def run_probes(plan: RunPlan, cfg: dict, clock: Clock, n_shards: int, device) ->
     out["workers"] = workers
     clock.add("probe", time.perf_counter() - tick)
     return out
+
+
+def torch_flags(trainer: dict) -> None:
+    """cuDNN autotuning and deterministic algorithms as the Lightning trainer will set them
+    (``benchmark``, ``deterministic``), so that the probes time the training's kernels."""
+    torch.backends.cudnn.benchmark = bool(trainer["benchmark"])
+    deterministic = trainer["deterministic"]
+    if deterministic:
+        torch.use_deterministic_algorithms(True, warn_only=deterministic == "warn")
 
 
 def _workers(plan: RunPlan, cfg: dict) -> int:
