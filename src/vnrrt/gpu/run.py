@@ -24,15 +24,14 @@ import time
 from pathlib import Path
 
 import lightning as L
-import numpy as np
 import torch
 
 from vnrrt.gpu import data as gdata
 from vnrrt.gpu.plan import Clock, RunPlan, load_config, parse_args
+from vnrrt.gpu.predict import evaluate
 from vnrrt.gpu.probe import (
     compile_pays,
     effective_rate,
-    infer_rate,
     loader_rate,
     probe_batch,
     probe_compiled,
@@ -48,7 +47,6 @@ from vnrrt.gpu.returned import (
 from vnrrt.gpu.train import curves_csv, make_datamodule, make_module, train_network
 from vnrrt.io import write_json, write_text
 from vnrrt.parallel import n_workers
-from vnrrt.predict.batch import heatmap_metrics, inputs, predict
 
 log = logging.getLogger("vnrrt.gpu")
 LOADER_SECONDS = 3.0  # the loader probe, at most
@@ -157,36 +155,6 @@ def torch_flags(trainer: dict) -> None:
 
 def _workers(plan: RunPlan, cfg: dict) -> int:
     return int(cfg["datamodule"]["num_workers"] if plan.workers is None else plan.workers)
-
-
-def heldout_metrics(maps: np.ndarray, instances: Instances, radius: float) -> dict:
-    """:func:`vnrrt.predict.batch.heatmap_metrics` over the random instances (``test/``,
-    the test split's, never trained on) and the named maps (``named/``)."""
-    kinds, out = np.array(instances.kinds), {}
-    for kind, prefix in (("random", "test"), ("named", "named")):
-        rows = np.flatnonzero(kinds == kind)
-        if len(rows):
-            found = heatmap_metrics(maps[rows], instances, rows, radius)
-            out.update({f"{prefix}/{k}": v for k, v in found.items()})
-    return {**out, "test_instances": int(np.sum(kinds == "random"))}
-
-
-def evaluate(module, instances: Instances, cfg: dict, device, batch: int) -> tuple:
-    """Heatmaps ``(N, S, S)`` float16 of every instance, and the network's inference
-    throughput, heldout metrics and the seconds of each part."""
-    ticks = [time.perf_counter()]
-    net = module.net.to(device).eval()
-    images = inputs(instances, range(len(instances)), module.record["render"])
-    maps, sec = predict(net, images, int(cfg["predict"]["batch_size"]), device)
-    ticks.append(time.perf_counter())
-    x = torch.from_numpy(images).repeat(-(-batch // len(images)), 1, 1, 1)[:batch]
-    rate = infer_rate(net, x.to(device), cfg["trainer"]["precision"])
-    ticks.append(time.perf_counter())
-    heldout = heldout_metrics(maps, instances, float(cfg["predict"]["metric_radius"]))
-    ticks.append(time.perf_counter())
-    seconds = dict(zip(("predict", "infer_probe", "metrics"), np.diff(ticks).tolist()))
-    found = {"ms_per_map": 1e3 * sec, "infer_images_per_s": rate, "infer_batch": batch}
-    return maps, {**found, "heldout": heldout, "seconds": seconds}
 
 
 def train_all(plan: RunPlan, cfg: dict, clock: Clock, doc: dict, instances, device) -> dict:
