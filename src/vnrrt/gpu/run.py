@@ -232,9 +232,9 @@ def run(plan: RunPlan, cfg: dict, instances: Instances, device: torch.device) ->
     """The whole run (module doc); returns the metrics document it writes."""
     clock = Clock(plan.budget_s)
     plain = {k: str(v) if isinstance(v, Path) else v for k, v in dataclasses.asdict(plan).items()}
+    got = first_data(plan, cfg, clock)
     doc = {"machine": machine(device), "budget_s": plan.budget_s, "plan": plain,
            "source": cfg["source"], "phases": clock.phases, "networks": {}}  # fmt: skip
-    got = first_data(plan, cfg, clock)
     doc["probe"] = run_probes(plan, cfg, clock, got["shards"], device)
     images = doc["probe"]["planned_images_per_s"] * plan.train_share * plan.budget_s
     doc["data"] = rest_of_data(plan, cfg, clock, got, images)
