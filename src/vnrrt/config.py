@@ -13,11 +13,14 @@ from __future__ import annotations
 
 import dataclasses
 import os
+from collections.abc import Mapping
 from pathlib import Path
-from typing import Any, TypeVar
+from typing import TYPE_CHECKING, Any, TypeVar
 
-from omegaconf import DictConfig, OmegaConf
-from omegaconf.errors import OmegaConfBaseException
+# omegaconf is imported inside the functions that use it: `check`, `ConfigError` and `asdict`
+# (which the data code imports) then work where it is not installed (scripts/gpu/).
+if TYPE_CHECKING:
+    from omegaconf import DictConfig
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
 CONF_DIR = Path(os.environ.get("VNRRT_CONF_DIR", REPO_ROOT / "conf"))
@@ -53,7 +56,10 @@ def section(cfg: DictConfig | dict, key: str, schema: type[T]) -> T:
     naming the offending ``key.subkey`` (defaults of the dataclasses serve library callers;
     a composed config must give every key).
     """
-    node = cfg.get(key) if isinstance(cfg, DictConfig | dict) else None
+    from omegaconf import OmegaConf
+    from omegaconf.errors import OmegaConfBaseException
+
+    node = cfg.get(key) if isinstance(cfg, Mapping) else None
     if node is None:
         raise ConfigError(f"config section {key!r} is missing")
     names = [f.name for f in dataclasses.fields(schema)]
@@ -88,6 +94,8 @@ def sections(cfg: DictConfig | dict, **schemas: type) -> dict[str, Any]:
 
 def load_params(path: str | Path = "params.yaml") -> DictConfig:
     """Load the composed parameters file (``params.yaml``) written by DVC or ``make params``."""
+    from omegaconf import DictConfig, OmegaConf
+
     path = Path(path)
     if not path.is_file():
         raise ConfigError(f"parameters file {path} not found (run `make params`)")
@@ -109,6 +117,8 @@ ALWAYS = ("paths", "logger", "workers")
 def restrict(cfg: DictConfig, keys: list[str], always: tuple[str, ...] = ALWAYS) -> DictConfig:
     """A copy of ``cfg`` holding only the dotted ``keys`` (and ``always``); reading any other
     key fails, so a stage can only use the parameters its ``dvc.yaml`` entry declares."""
+    from omegaconf import OmegaConf
+
     out = OmegaConf.create({})
     for key in [*always, *keys]:
         value = OmegaConf.select(cfg, key, default=_MISSING)
@@ -143,6 +153,7 @@ def compose(overrides: list[str] | tuple[str, ...] = ()) -> DictConfig:
     """Compose ``conf/config.yaml`` with Hydra overrides and resolve it, exactly as DVC does."""
     from hydra import compose as hydra_compose
     from hydra import initialize_config_dir
+    from omegaconf import OmegaConf
 
     with initialize_config_dir(str(CONF_DIR), version_base=None):
         cfg = hydra_compose(config_name="config", overrides=list(overrides))
@@ -152,6 +163,8 @@ def compose(overrides: list[str] | tuple[str, ...] = ()) -> DictConfig:
 
 def dump(cfg: DictConfig) -> str:
     """YAML text of a composed config, in the format DVC writes ``params.yaml``."""
+    from omegaconf import OmegaConf
+
     return OmegaConf.to_yaml(cfg)
 
 
