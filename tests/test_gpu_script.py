@@ -18,8 +18,9 @@ import torch
 from tests.train_helpers import SMALL
 from vnrrt.data.heatmaps import read_heatmaps, write_heatmaps
 from vnrrt.data.shards import shard_file
-from vnrrt.evaluation.build_instances import build_instances
+from vnrrt.evaluation.instances import build_instances
 from vnrrt.gpu.bundle import make_bundle
+from vnrrt.gpu.predict import metric_settings
 from vnrrt.gpu.returned import NETWORKS, Instances, ReturnedError, check_limits, read_returned
 from vnrrt.io import sha256
 from vnrrt.predict.batch import heatmap_metrics
@@ -108,10 +109,11 @@ def test_the_heatmaps_are_the_trained_checkpoints_predictions(returned, bundle):
 
 def test_the_metrics_are_those_of_the_returned_heatmaps(returned, bundle):
     instances = Instances(bundle / "instances.npz")
+    config = json.loads((bundle / "bundle" / "run_config.json").read_text())
     got = read_returned(returned, instances)
     rows = np.flatnonzero(np.array(instances.kinds) == "random")
     for name in NETWORKS:
-        ref = heatmap_metrics(got["maps"][name][rows], instances, rows, radius=3.0)
+        ref = heatmap_metrics(got["maps"][name][rows], instances, rows, metric_settings(config))
         recorded = got["metrics"]["networks"][name]["heldout"]
         assert recorded["test_instances"] == RANDOM
         for key, value in ref.items():

@@ -67,8 +67,12 @@ def run_config(overrides: list[str]) -> dict:
         "progress_every": int(cfg.callbacks.progress.every_n_steps),
         "predict": {
             "metric_radius": float(cfg.predict.metric_radius),
+            "metric_tau": float(cfg.predict.metric_tau),
+            "metric_ap_radius": float(cfg.predict.metric_ap_radius),
+            "metric_endpoint_radius": float(cfg.predict.metric_endpoint_radius),
             "batch_size": int(cfg.predict.batch_size),
         },
+        "planner": {"taus": [float(t) for t in cfg.planner.taus], "tau": float(cfg.planner.tau)},
         "source": {"overrides": list(overrides), "commit": _commit()},
     }
 

@@ -11,17 +11,31 @@ import torch
 
 from vnrrt.gpu.probe import infer_rate
 from vnrrt.gpu.returned import Instances
-from vnrrt.predict.batch import heatmap_metrics, inputs, predict
+from vnrrt.names import mask_taus
+from vnrrt.predict.batch import MetricSettings, heatmap_metrics, inputs, predict
 
 
-def heldout_metrics(maps: np.ndarray, instances: Instances, radius: float) -> dict:
+def metric_settings(cfg: dict) -> MetricSettings:
+    """The heatmap metrics' settings of the bundle's config (``predict.metric_*``, the
+    M-VNRRT* thresholds), as the ``predict_metrics`` stage uses them."""
+    p, planner = cfg["predict"], cfg["planner"]
+    return MetricSettings(
+        float(p["metric_radius"]),
+        float(p["metric_tau"]),
+        float(p["metric_ap_radius"]),
+        float(p["metric_endpoint_radius"]),
+        tuple(mask_taus(planner["taus"], planner["tau"])),
+    )
+
+
+def heldout_metrics(maps: np.ndarray, instances: Instances, ms: MetricSettings) -> dict:
     """:func:`vnrrt.predict.batch.heatmap_metrics` over the random instances (``test/``,
     the test split's, never trained on) and the named maps (``named/``)."""
     kinds, out = np.array(instances.kinds), {}
     for kind, prefix in (("random", "test"), ("named", "named")):
         rows = np.flatnonzero(kinds == kind)
         if len(rows):
-            found = heatmap_metrics(maps[rows], instances, rows, radius)
+            found = heatmap_metrics(maps[rows], instances, rows, ms)
             out.update({f"{prefix}/{k}": v for k, v in found.items()})
     return {**out, "test_instances": int(np.sum(kinds == "random"))}
 
@@ -37,7 +51,7 @@ def evaluate(module, instances: Instances, cfg: dict, device, batch: int) -> tup
     x = torch.from_numpy(images).repeat(-(-batch // len(images)), 1, 1, 1)[:batch]
     rate = infer_rate(net, x.to(device), cfg["trainer"]["precision"])
     ticks.append(time.perf_counter())
-    heldout = heldout_metrics(maps, instances, float(cfg["predict"]["metric_radius"]))
+    heldout = heldout_metrics(maps, instances, metric_settings(cfg))
     ticks.append(time.perf_counter())
     seconds = dict(zip(("predict", "infer_probe", "metrics"), np.diff(ticks).tolist()))
     found = {"ms_per_map": 1e3 * sec, "infer_images_per_s": rate, "infer_batch": batch}

@@ -28,7 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from vnrrt.data.heatmaps import HeatmapError, part_file, part_rows, read_heatmaps, write_heatmaps
-from vnrrt.evaluation.instances import Instances  # the one import of the instances format
+from vnrrt.data.instances import Instances  # the one import of the instances format
 from vnrrt.io import sha256
 
 MAX_FILES, MAX_DEPTH = 8, 2
