@@ -172,11 +172,11 @@ def test_improvement_is_the_papers_formula():
         (4.2, 0.8, 1.2, "same direction, smaller effect"),
         (0.3, 0.8, 1.2, "same direction, larger effect"),
         (-0.1, 0.8, 1.2, "reversed"),
-        (0.7, -0.1, 0.3, "not reproduced"),
+        (0.7, -0.1, 0.3, "no clear effect"),
         (-0.1, -0.3, -0.05, "reproduced"),
         (-0.5, -0.3, -0.05, "same direction, smaller effect"),
         (-0.01, -0.3, -0.05, "same direction, larger effect"),
-        (0.5, float("nan"), 1.0, "not reproduced"),
+        (0.5, float("nan"), 1.0, "no clear effect"),
     ],
 )
 def test_verdict_rules(quoted, lo, hi, expected):

@@ -302,10 +302,11 @@ RULES = """How to read the tables:
   median(planner); its {level} CI ({bootstrap} bootstrap resamples) resamples base maps
   (instances of one map are not independent), then instances, then trials within each
   instance. The paper's ratio of means is shown beside it.
-- Verdicts: "reproduced" = same sign and the paper's value inside our CI; "same direction,
-  smaller/larger effect" = the CI excludes zero on the paper's side but not its value;
-  "not reproduced" = the CI contains zero (no effect shown); "reversed" = the CI excludes
-  zero on the other side.
+- Verdicts (one per claim, on time; at the claims' corrected level): "reproduced" = same sign
+  and the paper's value inside our CI; "same direction, smaller/larger effect" = the CI
+  excludes zero on the paper's side but not its value; "no clear effect" = the CI contains
+  zero; "reversed" = the CI excludes zero on the other side. Beside it, against the paper's
+  own interval: "compatible with the paper's data" or "contradicts the paper's data".
 - Our named maps are our own (built to the paper's difficulty ordering, not to its
   geometry, which the paper does not give), so claims on Maps 1-5 are marked "different map:
   not comparable"; the random-maps column is the comparable one."""

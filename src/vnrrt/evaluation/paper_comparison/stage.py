@@ -33,29 +33,36 @@ def evaluate_settings(cfg: DictConfig) -> dict:
 def run_evaluate(cfg: DictConfig) -> dict:
     """Stage ``evaluate`` (module doc); returns the summary."""
     from vnrrt.data.instances import Instances
-    from vnrrt.evaluation.paper_comparison.summary import analyze, convergence_curves
-    from vnrrt.evaluation.paper_tables import load_paper_tables
+    from vnrrt.evaluation.paper_comparison.summary import convergence_curves
     from vnrrt.evaluation.protocol import configurations, trial_counts, trial_jobs
     from vnrrt.evaluation.table import merge_parts, write_table
     from vnrrt.io import read_json, write_json, write_text
 
     s = evaluate_settings(cfg)
-    paths, ev, st, rules = s["paths"], s["eval"], s["stats"], s["planner"]
+    paths, ev, rules = s["paths"], s["eval"], s["planner"]
     keys = configurations(ev, rules.mask_taus, rules.tau)
     jobs = trial_jobs(Instances(paths.instances).kinds, keys, trial_counts(ev))
     table = merge_parts(paths.trials, ev.parts, sum(j.count for j in jobs))
     write_table(table, paths.trials_table)
-    paper = load_paper_tables(paths.paper_tables)
-    eps = rules.eps
-    networks = read_json(paths.predict_metrics)["networks"]
-    inference = {n: float(m["ms_per_map"]) for n, m in networks.items()}
-    summary = analyze(table, paper, eps, st, inference)
+    summary = evaluate_summary(table, s, read_json(paths.predict_metrics))
     write_json(paths.summary, summary)
-    curves = convergence_curves(table, eps)
+    curves = convergence_curves(table, rules.eps)
     write_text(paths.convergence, curves.to_csv(index=False))
     for map_set, frame in series_per_map_set(curves).items():
         write_text(Path(paths.convergence_plots) / f"{map_set}.csv", frame.to_csv(index=False))
     return summary
+
+
+def evaluate_summary(table, s: dict, predict: dict) -> dict:
+    """The summary of the merged trial ``table`` (:func:`.summary.analyze`) with stage
+    ``evaluate``'s settings ``s`` and the networks' inference times of ``predict``
+    (``predict.json``)."""
+    from vnrrt.evaluation.paper_comparison.summary import analyze
+    from vnrrt.evaluation.paper_tables import load_paper_tables
+
+    paper = load_paper_tables(s["paths"].paper_tables)
+    inference = {n: float(m["ms_per_map"]) for n, m in predict["networks"].items()}
+    return analyze(table, paper, s["planner"].eps, s["stats"], inference)
 
 
 def series_per_map_set(curves) -> dict:
@@ -92,46 +99,49 @@ def report_settings(cfg: DictConfig) -> dict:
     return typed | {"paper_settings": settings, "values": values}
 
 
+def report_text(s: dict, summary: dict, predict: dict, trainings: dict, optima: dict) -> str:
+    """``paper_comparison.md`` from stage ``report``'s settings ``s``, the ``summary``, the
+    networks' ``predict.json`` and training metrics (``trainings``: network -> metrics) and
+    the instances' optimal lengths (``optima``)."""
+    from vnrrt.evaluation.config import mask_taus
+    from vnrrt.evaluation.paper_comparison.report import ReportInputs, build_report, metric_settings
+    from vnrrt.evaluation.paper_tables import load_paper_tables
+    from vnrrt.evaluation.protocol import configurations
+
+    ev, planner = s["eval"], s["planner"]
+    keys = configurations(ev, mask_taus(planner.taus, planner.tau), planner.tau)
+    inputs = ReportInputs(
+        summary,
+        load_paper_tables(s["paths"].paper_tables),
+        optima,
+        {k.text: k.source for k in keys if k.source},
+        s["scale"]["name"],
+        predict["networks"],
+        metric_settings(predict["settings"]),
+        s["paper_settings"],
+        s["values"],
+        trainings,
+    )
+    return build_report(inputs)
+
+
 def run_report(cfg: DictConfig) -> Path:
     """Stage ``report`` (module doc); returns the report's path."""
     from vnrrt import tracking
     from vnrrt.data.instances import Instances
-    from vnrrt.evaluation.config import mask_taus
-    from vnrrt.evaluation.paper_comparison.report import (
-        ReportInputs,
-        build_report,
-        headline,
-        metric_settings,
-    )
-    from vnrrt.evaluation.paper_tables import load_paper_tables
-    from vnrrt.evaluation.protocol import configurations
+    from vnrrt.evaluation.paper_comparison.report import headline
     from vnrrt.io import read_json, write_json, write_text
 
     s = report_settings(cfg)
     paths, ev, planner, logger, scale = s["paths"], s["eval"], s["planner"], s["logger"], s["scale"]
     if logger.enabled:  # an unreachable store fails here, before any work
         tracking.check_store(tracking.tracking_uri(logger.uri))
-    keys = configurations(ev, mask_taus(planner.taus, planner.tau), planner.tau)
     summary, predict = read_json(paths.summary), read_json(paths.predict_metrics)
-    networks = predict["networks"]
-    trainings = {n: read_json(paths.train_metrics(n)) for n in networks}
-    text = build_report(
-        ReportInputs(
-            summary,
-            load_paper_tables(paths.paper_tables),
-            Instances(paths.instances).optima(),
-            {k.text: k.source for k in keys if k.source},
-            scale["name"],
-            networks,
-            metric_settings(predict["settings"]),
-            s["paper_settings"],
-            s["values"],
-            trainings,
-        )
-    )
-    write_text(paths.report, text)
+    trainings = {n: read_json(paths.train_metrics(n)) for n in predict["networks"]}
+    optima = Instances(paths.instances).optima()
+    write_text(paths.report, report_text(s, summary, predict, trainings, optima))
     figures = save_figures(paths, summary)
-    metrics = headline(summary, networks)
+    metrics = headline(summary, predict["networks"])
     write_json(paths.headline, metrics)
     if logger.enabled:
         from vnrrt.evaluation.paper_comparison.runs import log_evaluation

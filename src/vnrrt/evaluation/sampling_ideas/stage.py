@@ -149,45 +149,77 @@ def run_regime_part(cfg: DictConfig, part: int) -> int:
     return _run_part(cfg, part, "regime")
 
 
-def run_ideas(cfg: DictConfig) -> dict:
-    """Stage ``ideas`` (module doc); returns the summary."""
-    import os
-
-    from vnrrt import tracking
-    from vnrrt.evaluation.paper_tables import claim_pairs, load_paper_tables
-    from vnrrt.evaluation.protocol import configurations
-    from vnrrt.evaluation.sampling_ideas.report import build_ideas_report
-    from vnrrt.evaluation.sampling_ideas.summary import analyze_study
+def ideas_tables(settings: dict) -> dict:
+    """The oracle study's and the regime sweep's trial parts merged (checked complete), with
+    stage ``ideas``'s settings: ``{"oracle": table, "regime": table}``."""
     from vnrrt.evaluation.table import merge_parts
-    from vnrrt.io import write_json, write_text
 
-    settings = ideas_settings(cfg)
-    rules, st, logger = settings["planner"], settings["stats"], settings["logger"]
-    if logger.enabled:  # an unreachable store fails here, before any work
-        tracking.check_store(tracking.tracking_uri(logger.uri))
-    s, scale = _study(settings), settings["scale"]["name"]
-    tables = {}
+    s, tables = _study(settings), {}
     for which in ("oracle", "regime"):
         folder = s.paths.oracle if which == "oracle" else s.paths.regime
         rows = sum(j.count for j in s.jobs(which))
         tables[which] = merge_parts(folder, s.design(which)[3], rows)
+    return tables
+
+
+def ideas_summary(tables: dict, settings: dict) -> dict:
+    """The study's statistics (:func:`.summary.analyze_study`) of the merged ``tables``
+    with stage ``ideas``'s settings, which the summary records (``settings``)."""
+    from vnrrt.evaluation.paper_tables import claim_pairs, load_paper_tables
+    from vnrrt.evaluation.protocol import configurations
+    from vnrrt.evaluation.sampling_ideas.summary import analyze_study
+
+    s, rules, st = _study(settings), settings["planner"], settings["stats"]
     networks = [k.text for k in configurations(s.configurations, s.taus, s.tau) if k.source]
     pairs = claim_pairs(load_paper_tables(s.paths.paper_tables))
     shown = {"eps": rules.eps, "level": st.level, "bootstrap": st.bootstrap}
     shown |= {"radius": s.oracle.radius, "sigma": s.oracle.sigma, "floor": s.oracle.floor}
-    summary = analyze_study(tables["oracle"], tables["regime"], networks, pairs, shown)
-    write_json(s.paths.ideas_summary, summary)
-    written = save_figures(s.paths, summary)
-    report = Path(s.paths.ideas_report)
-    relative = [os.path.relpath(f, report.parent) for f in written]
-    write_text(report, build_ideas_report(summary, scale, relative))
+    return analyze_study(tables["oracle"], tables["regime"], networks, pairs, shown)
+
+
+def ideas_text(summary: dict, settings: dict) -> str:
+    """``sampling_ideas.md`` of the summary, its figures linked relative to the report."""
+    import os
+
+    from vnrrt.evaluation.sampling_ideas.report import build_ideas_report
+
+    paths = settings["paths"]
+    report = Path(paths.ideas_report)
+    relative = [os.path.relpath(f, report.parent) for f in figure_files(paths, summary)]
+    return build_ideas_report(summary, settings["scale"]["name"], relative)
+
+
+def run_ideas(cfg: DictConfig) -> dict:
+    """Stage ``ideas`` (module doc); returns the summary."""
+    from vnrrt import tracking
+    from vnrrt.io import read_json, write_json, write_text
+
+    settings = ideas_settings(cfg)
+    logger, paths = settings["logger"], settings["paths"]
+    if logger.enabled:  # an unreachable store fails here, before any work
+        tracking.check_store(tracking.tracking_uri(logger.uri))
+    write_json(paths.ideas_summary, ideas_summary(ideas_tables(settings), settings))
+    summary = read_json(paths.ideas_summary)  # what every reader sees: the file's numbers
+    written = save_figures(paths, summary)
+    write_text(paths.ideas_report, ideas_text(summary, settings))
     if logger.enabled:
         from vnrrt.evaluation.sampling_ideas.runs import log_ideas
 
-        params = {"oracle": asdict(s.oracle), "regime": asdict(s.regime)}
-        artifacts = [report, Path(s.paths.ideas_summary), *written]
-        log_ideas(logger, scale, params, summary, artifacts)
+        params = {"oracle": asdict(settings["oracle"]), "regime": asdict(settings["regime"])}
+        artifacts = [Path(paths.ideas_report), Path(paths.ideas_summary), *written]
+        log_ideas(logger, settings["scale"]["name"], params, summary, artifacts)
     return summary
+
+
+def figure_files(paths: Paths, summary: dict) -> list[Path]:
+    """The figures :func:`save_figures` draws for ``summary``: the quality curve when the
+    study has one, a regime figure per optimal stop rule of the sweep."""
+    figs, out = Path(paths.ideas_figures), []
+    if summary["curves"]:
+        out.append(figs / "quality_curve.png")
+    stops = {r["stop"] for r in summary["regime"]}
+    out += [figs / f"regime_{s}.png" for s in ("optimal", "optimal_any_angle") if s in stops]
+    return out
 
 
 def save_figures(paths: Paths, summary: dict) -> list[Path]:
@@ -197,14 +229,13 @@ def save_figures(paths: Paths, summary: dict) -> list[Path]:
 
     from vnrrt.viz.ideas import save_quality, save_regime
 
-    figs, written = Path(paths.ideas_figures), []
+    written = figure_files(paths, summary)
     curves, nets = pd.DataFrame(summary["curves"]), pd.DataFrame(summary["networks"])
-    if not curves.empty:
-        save_quality(figs / "quality_curve.png", curves, nets, summary["settings"])
-        written.append(figs / "quality_curve.png")
     sweep = pd.DataFrame(summary["regime"])
-    for stop in ("optimal", "optimal_any_angle"):
-        if not sweep.empty and stop in set(sweep["stop"]):
-            save_regime(figs / f"regime_{stop}.png", sweep, stop, summary["settings"])
-            written.append(figs / f"regime_{stop}.png")
+    for path in written:
+        if path.name == "quality_curve.png":
+            save_quality(path, curves, nets, summary["settings"])
+        else:
+            stop = path.stem.removeprefix("regime_")
+            save_regime(path, sweep, stop, summary["settings"])
     return written
