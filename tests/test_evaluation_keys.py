@@ -84,3 +84,14 @@ def test_a_bad_key_is_refused_naming_it(text, why):
     with pytest.raises(ConfigError, match=why) as err:
         ConfigKey.parse(text)
     assert repr(text) in str(err.value)
+
+
+@pytest.mark.parametrize(
+    "text",
+    ["vnrrt_star~0.25[oracle_vertex@s4]", "nrrt_star[oracle_blend@w0.5@s2]+free",
+     "m_vnrrt_star@0.5{noends}~0.75[vertexnet]+free+informed", "rrt_star+free"],
+)  # fmt: skip
+def test_family_keys_round_trip(text):
+    key = ConfigKey.parse(text, SOURCES)
+    assert key.text == text and ConfigKey.parse(key.text, SOURCES) == key
+    assert key.free == ("+free" in text) and (key.mix is None) == ("~" not in text)

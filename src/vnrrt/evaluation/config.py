@@ -8,11 +8,12 @@ serve library callers and never stand in for a config key inside the pipeline.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 from vnrrt.config import ConfigError, check, check_parts
 from vnrrt.evaluation.keys import MASK_VARIANTS, ConfigKey
-from vnrrt.evaluation.sources import ORACLE_KINDS
+from vnrrt.evaluation.oracles import ORACLE_KINDS
 from vnrrt.names import PLANNERS, mask_taus
 
 DEFAULT_SOURCES = {"nrrt_star": "nrrtnet", "vnrrt_star": "vertexnet", "m_vnrrt_star": "vertexnet"}
@@ -31,6 +32,7 @@ class Configurations:
     mask_variants: list[str] = field(default_factory=list)  # M-VNRRT* at planner.tau, masked so
     masked_controls: bool = False  # M-VNRRT* at planner.tau on the NRRT* network's heatmap
     endpoint_radius: float = 3.0  # start/goal disks (px): the noends mask, the mass shares
+    zero_obstacles: bool = False  # the obstacle rule: sample free cells only (heatmaps, uniform)
 
     def validate(self) -> None:
         """Raise :class:`ConfigError` naming the first invalid value."""
@@ -38,6 +40,8 @@ class Configurations:
         check(not bad, "eval.mask_variants", self.mask_variants, f"known: {list(MASK_VARIANTS)}")
         check(isinstance(self.masked_controls, bool), "eval.masked_controls",
               self.masked_controls, "true or false")  # fmt: skip
+        check(isinstance(self.zero_obstacles, bool), "eval.zero_obstacles",
+              self.zero_obstacles, "true or false")  # fmt: skip
         ok = self.endpoint_radius >= 0
         check(ok, "eval.endpoint_radius", self.endpoint_radius, "must be >= 0 px")
         if self.masked_controls:
@@ -124,53 +128,77 @@ class StatsConfig:
 
 @dataclass
 class OracleConfig:
-    """The ``oracle`` section: the oracle study (:mod:`vnrrt.evaluation.sampling_ideas`)."""
+    """The ``oracle`` section: the oracle families of the sampling-ideas study
+    (:mod:`vnrrt.evaluation.sampling_ideas`)."""
 
-    kinds: list[str] = field(default_factory=lambda: list(ORACLE_KINDS))
-    sigma: float = 1.0
+    families: dict[str, list[str]] = field(default_factory=lambda: {
+        "path": ["oracle_path", "oracle_taut_path"],
+        "vertex": ["oracle_vertex", "oracle_vertex_endpoints", "oracle_taut_vertex"],
+        "control": ["oracle_endpoints"],
+    })  # fmt: skip
+    sigmas: list[float] = field(default_factory=lambda: [1.0, 2.0, 4.0, 8.0, 16.0])
+    mixes: list[float] = field(default_factory=lambda: [0.25, 0.5, 0.75])
+    blend_weights: list[float] = field(default_factory=lambda: [0.0, 0.25, 0.5, 0.75, 1.0])
     floor: float = 0.0
     radius: float = 3.0
     qualities: list[float] = field(default_factory=lambda: [1.0, 0.5, 0.2, 0.1, 0.05, 0.02, 0.0])
     random_maps: int = 1000
-    trials: int = 1
+    selection_share: float = 0.5
+    trials: int = 2
     parts: list[int] = field(default_factory=lambda: [0])
 
     def validate(self) -> None:
-        unknown = sorted(set(self.kinds) - set(ORACLE_KINDS))
-        check(not unknown, "oracle.kinds", self.kinds, f"known: {ORACLE_KINDS}")
-        check(self.sigma >= 0, "oracle.sigma", self.sigma, "must be >= 0 px")
+        check(set(self.families) >= {"path", "vertex"}, "oracle.families", list(self.families),
+              "needs the path and vertex ideas")  # fmt: skip
+        for idea, kinds in self.families.items():
+            bad = sorted(set(kinds) - set(ORACLE_KINDS))
+            ok = bool(kinds) and not bad
+            check(ok, f"oracle.families.{idea}", kinds, f"known: {ORACLE_KINDS}")
+        ok = bool(self.sigmas) and all(s >= 0 for s in self.sigmas)
+        check(ok, "oracle.sigmas", self.sigmas, "every blur must be >= 0 px")
+        ok = bool(self.mixes) and all(0 < m <= 1 for m in self.mixes)
+        check(ok, "oracle.mixes", self.mixes, "every mix must be in (0, 1]")
+        ok = bool(self.blend_weights) and all(0 <= w <= 1 for w in self.blend_weights)
+        check(ok, "oracle.blend_weights", self.blend_weights, "every w must be in [0, 1]")
         check(0 <= self.floor <= 1, "oracle.floor", self.floor, "must be in [0, 1]")
         check(self.radius >= 0, "oracle.radius", self.radius, "must be >= 0 px")
         ok = bool(self.qualities) and all(0 <= q <= 1 for q in self.qualities)
         check(ok, "oracle.qualities", self.qualities, "every q must be in [0, 1]")
-        check(self.random_maps >= 1, "oracle.random_maps", self.random_maps, "must be >= 1")
-        check(self.trials >= 1, "oracle.trials", self.trials, "must be >= 1")
+        check(self.random_maps >= 2, "oracle.random_maps", self.random_maps, "must be >= 2")
+        ok = 0 < self.selection_share < 1
+        check(ok, "oracle.selection_share", self.selection_share, "must be in (0, 1)")
+        check(self.trials >= 2, "oracle.trials", self.trials, "must be >= 2 (paired CIs)")
         check_parts(self.parts, "oracle.parts")
 
 
 @dataclass
 class RegimeConfig:
-    """The ``regime`` section: the planner-regime sweep."""
+    """The ``regime`` section: the planner-regime sweep (its cells and configurations)."""
 
-    etas: list[float] = field(default_factory=lambda: [3.0, 5.0, 10.0, 20.0, 40.0])
-    radius_modes: list[str] = field(default_factory=lambda: list(REGIME_RADIUS_MODES))
-    goal_radii: list = field(default_factory=lambda: [None, 2.0])
+    etas: list[float] = field(default_factory=lambda: [5.0, 10.0, 20.0, 40.0, math.inf])
+    radius_modes: list[str] = field(default_factory=lambda: ["shrinking", "fixed1"])
+    gamma_factors: list[float] = field(default_factory=lambda: [1.0, 0.1, 0.01])
+    goal_radii: list = field(default_factory=lambda: [None, math.inf])
     configurations: list[str] = field(default_factory=lambda: ["rrt_star"])
     random_maps: int = 1000
+    trials: int = 2
     parts: list[int] = field(default_factory=lambda: [0])
 
     def validate(self) -> None:
         ok = bool(self.etas) and all(e > 0 for e in self.etas)
-        check(ok, "regime.etas", self.etas, "every step must be > 0 px")
+        check(ok, "regime.etas", self.etas, "every step must be > 0 px (.inf: unlimited)")
         bad = sorted(set(self.radius_modes) - set(REGIME_RADIUS_MODES))
         ok = not bad and bool(self.radius_modes)
         check(ok, "regime.radius_modes", bad, f"known {REGIME_RADIUS_MODES}")
+        ok = bool(self.gamma_factors) and all(0 < g < math.inf for g in self.gamma_factors)
+        check(ok, "regime.gamma_factors", self.gamma_factors, "every factor must be finite, > 0")
         ok = all(g is None or g > 0 for g in self.goal_radii) and bool(self.goal_radii)
-        check(ok, "regime.goal_radii", self.goal_radii, "null or > 0 px")
+        check(ok, "regime.goal_radii", self.goal_radii, "null, > 0 px or .inf")
         for key in self.configurations:
             try:
                 ConfigKey.parse(key)
             except ConfigError as err:
                 raise ConfigError(f"invalid regime.configurations entry {key!r}: {err}") from None
         check(self.random_maps >= 1, "regime.random_maps", self.random_maps, "must be >= 1")
+        check(self.trials >= 1, "regime.trials", self.trials, "must be >= 1")
         check_parts(self.parts, "regime.parts")

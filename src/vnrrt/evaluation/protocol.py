@@ -101,11 +101,13 @@ def trial_jobs(
     per_job: int = TRIALS_PER_JOB,
     regimes: tuple[str, ...] = ("",),
     instances: list[int] | None = None,
+    seq: int = 0,
 ) -> list[TrialJob]:
     """Every job in canonical order; ``kinds[i]`` is ``'named'`` or ``'random'`` for
     instance ``i``, ``counts`` as :func:`trial_counts` returns; ``instances`` restricts the
-    instances (default: all) and ``regimes`` repeats everything per regime-sweep cell."""
-    jobs, seq = [], 0
+    instances (default: all), ``regimes`` repeats everything per regime-sweep cell and ``seq``
+    is the first row's number."""
+    jobs = []
     chosen = range(len(kinds)) if instances is None else instances
     for regime in regimes:
         for i in chosen:

@@ -82,7 +82,8 @@ def run_trials_part(cfg: DictConfig, part: int) -> int:
     log.info(
         "part %d/%d: %d trial jobs on %d instances", part, len(ev.parts), len(jobs), len(instances)
     )
-    heat = HeatSettings(s["oracle"]["radius"], ev.endpoint_radius, targets)
+    heat = HeatSettings(s["oracle"]["radius"], ev.endpoint_radius, targets,
+                        zero_obstacles=ev.zero_obstacles)  # fmt: skip
     table = run_jobs(jobs, instances, s["seed"], s["workers"], planner, heat)
     write_table(table, paths.trials_part(part))
     return len(table)

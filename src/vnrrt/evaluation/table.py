@@ -61,6 +61,7 @@ class TrialRow:
     convergence: tuple[float, ...] = ()  # s to CONVERGENCE_FACTORS x reference (optimal)
     regime: str = ""  # planner settings of a regime-sweep cell ('' = the protocol's)
     heat_mass: float = math.nan  # share of the heatmap's mass within r px of its target
+    uniform_mass: float = math.nan  # the same share of a uniform map (over the allowed cells)
     # where the sampler's heatmap weights lie (after M-VNRRT*'s mask; vnrrt.evaluation.sources)
     mass_endpoints: float = math.nan  # on the start/goal disks
     mass_interior: float = math.nan  # near the interior vertices

@@ -26,9 +26,10 @@ from vnrrt.data.instances import EvalInstance
 from vnrrt.evaluation import sources
 from vnrrt.evaluation.keys import ConfigKey
 from vnrrt.evaluation.protocol import TrialJob, trial_jobs, trial_seed
+from vnrrt.evaluation.sampling import build_sampler, free_rule
 from vnrrt.evaluation.table import CONVERGENCE_FACTORS, TrialRow, frame
 from vnrrt.parallel import parallel_map
-from vnrrt.planners import PlannerConfig, make_sampler, plan, warmup
+from vnrrt.planners import PlannerConfig, plan, warmup
 
 
 @dataclass(frozen=True)
@@ -38,16 +39,18 @@ class HeatSettings:
     ``eval.endpoint_radius``: the ``noends`` mask and the mass shares), the target of each
     trained network (``'path'`` or ``'interior_vertices'``), and the oracles' blur ``sigma``
     (px) and uniform ``floor`` (``oracle.sigma``, ``oracle.floor``; None where a stage samples
-    no oracle)."""
+    no oracle), and the default obstacle rule (``eval.zero_obstacles``; a key's ``+free``
+    flips it: :mod:`vnrrt.evaluation.sampling`)."""
 
     radius: float
     endpoint_radius: float
     targets: dict[str, str]
     sigma: float | None = None
     floor: float | None = None
+    zero_obstacles: bool = False  # the default obstacle rule (eval.zero_obstacles)
 
 
-def _row(job, inst, trial, seed, result, setup, ref, mass, shares) -> TrialRow:
+def _row(job, inst, trial, seed, result, setup, ref, measured) -> TrialRow:
     key = job.key
     return TrialRow(
         seq=job.seq + trial - job.first,
@@ -75,8 +78,7 @@ def _row(job, inst, trial, seed, result, setup, ref, mass, shares) -> TrialRow:
         setup_time=setup,
         convergence=tuple(m.time for m in result.milestones),
         regime=job.regime,
-        heat_mass=mass,
-        **shares,
+        **measured,
     )
 
 
@@ -93,16 +95,15 @@ def run_job(
     if key.informed:
         config = config.replace(informed=True)
     warmup()
-    heatmap, mass, shares = None, math.nan, {}
+    free = free_rule(key, heat.zero_obstacles)
+    allowed = sources.allowed_cells(inst.grid, free)
+    heatmap, measured = None, {}
     if key.source is not None:
-        heatmap = sources.source_heatmap(key.source, inst, heat.sigma, heat.floor)
+        heatmap = sources.source_heatmap(key.source, inst, heat.sigma, heat.floor, allowed)
         heatmap = sources.mask_variant(heatmap, key.mask, inst, heat.endpoint_radius)
-        mask = sources.target_mask(inst, sources.source_target(key.source, heat.targets))
-        mass = sources.mass_near(heatmap, mask, heat.radius)
-        weights = heatmap if key.tau is None else np.where(heatmap >= key.tau, heatmap, 0.0)
-        shares = sources.mass_shares(weights, inst, heat.radius, heat.endpoint_radius)
+        measured = _measure(key, heatmap, allowed, inst, heat)
     tick = time.perf_counter()
-    sampler = make_sampler(key.planner, inst.grid.shape, heatmap, key.tau, config.mix)
+    sampler, config = build_sampler(key, heatmap, allowed, config, free)
     setup = time.perf_counter() - tick
     ref = inst.reference(stop)
     milestones = tuple(f * ref for f in CONVERGENCE_FACTORS) if stop != "initial" else ()
@@ -121,8 +122,22 @@ def run_job(
             milestones=milestones,
             config=config,
         )
-        rows.append(_row(job, inst, trial, s, r, setup, ref, mass, shares))
+        rows.append(_row(job, inst, trial, s, r, setup, ref, measured))
     return rows
+
+
+def _measure(key: ConfigKey, heatmap: np.ndarray, allowed: np.ndarray, inst: EvalInstance,
+             heat: HeatSettings) -> dict:  # fmt: skip
+    """What a configuration's heatmap is worth: its mass near its target (``heat_mass``), a
+    uniform map's over the allowed cells (``uniform_mass``), and where the sampler's weights
+    lie after the mask (:func:`vnrrt.evaluation.sources.mass_shares`)."""
+    mask = sources.target_mask(inst, sources.source_target(key.source, heat.targets))
+    weights = heatmap if key.tau is None else np.where(heatmap >= key.tau, heatmap, 0.0)
+    return {
+        "heat_mass": sources.mass_near(heatmap, mask, heat.radius),
+        "uniform_mass": sources.mass_near(allowed.astype(np.float64), mask, heat.radius),
+        **sources.mass_shares(weights, inst, heat.radius, heat.endpoint_radius),
+    }
 
 
 def _needed(job: TrialJob, inst: EvalInstance) -> tuple[TrialJob, EvalInstance]:

@@ -95,7 +95,7 @@ def _params(cfg: PlannerConfig, occ: np.ndarray, start, goal) -> core.Params:
         gamma = 2.0 * math.sqrt(1.5) * math.sqrt(np.count_nonzero(occ == 0) / math.pi)
     return core.Params(
         eta=float(cfg.eta),
-        gamma=float(gamma) if cfg.radius_mode == "shrinking" else 0.0,
+        gamma=float(gamma) * cfg.gamma_factor if cfg.radius_mode == "shrinking" else 0.0,
         radius=float(cfg.fixed_radius),
         goal_radius=float(cfg.eta if cfg.goal_radius is None else cfg.goal_radius),
         sx=float(start[0]),
@@ -103,7 +103,7 @@ def _params(cfg: PlannerConfig, occ: np.ndarray, start, goal) -> core.Params:
         gx=float(goal[0]),
         gy=float(goal[1]),
         min_spacing=float(cfg.min_spacing),
-        bucket=max(cfg.eta / 2, 1.0),
+        bucket=max(min(cfg.eta, max(occ.shape)) / 2, 1.0),  # an unlimited step: the map
         informed=bool(cfg.informed),
     )
 

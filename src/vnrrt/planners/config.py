@@ -31,6 +31,8 @@ class PlannerConfig:
             ``'fixed'``: ``fixed_radius``.
         gamma: shrinking-radius constant; ``None`` uses the RRT* bound
             ``2 sqrt(1.5) sqrt(free area / pi)`` of the map (Karaman and Frazzoli).
+        gamma_factor: the shrinking radius's constant is ``gamma_factor x gamma`` (below 1
+            the radius falls below ``eta`` within a run: the regime sweep's radius rules).
         fixed_radius: near radius in ``'fixed'`` mode (pixels).
         goal_radius: a node within this distance connects to the goal point by a
             collision-free straight segment; ``None`` means ``eta``; ``.inf``: any node
@@ -59,6 +61,7 @@ class PlannerConfig:
     eta: float = 10.0
     radius_mode: str = "shrinking"
     gamma: float | None = None
+    gamma_factor: float = 1.0
     fixed_radius: float = 10.0
     goal_radius: float | None = None
     mix: float = 0.5
@@ -75,9 +78,13 @@ class PlannerConfig:
 
     def validate(self) -> None:
         """Raise :class:`PlannerConfigError` naming the first invalid value."""
-        for name in ("eta", "fixed_radius", "max_seconds"):
+        for name in ("fixed_radius", "max_seconds"):
             v = getattr(self, name)
             self._check(name, _finite(v) and v > 0, "> 0")
+        ok = _number(self.eta) and self.eta > 0
+        self._check("eta", ok, "> 0 (.inf: steer straight to the sample)")
+        ok = _finite(self.gamma_factor) and self.gamma_factor > 0
+        self._check("gamma_factor", ok, "finite and > 0")
         self._check(
             "gamma", self.gamma is None or (_finite(self.gamma) and self.gamma > 0), "null or > 0"
         )
@@ -120,6 +127,10 @@ class PlannerConfig:
 
 def _integer(v) -> bool:
     return isinstance(v, int) and not isinstance(v, bool)
+
+
+def _number(v) -> bool:
+    return isinstance(v, int | float) and not isinstance(v, bool) and not math.isnan(v)
 
 
 def _finite(v) -> bool:

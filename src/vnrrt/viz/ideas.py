@@ -15,27 +15,28 @@ from vnrrt.viz.common import log_ticks, save_figure
 
 QUALITY_STOPS = ("initial", "optimal", "optimal_any_angle")
 
-IDEA_NAMES = {"oracle_path": "path oracle", "oracle_vertex": "vertex oracle"}
+IDEA_NAMES = {"path": "path envelope", "vertex": "vertex envelope"}
 
 
 def quality_figure(
     curves: pd.DataFrame, networks: pd.DataFrame, settings: dict, metric: str = "iterations"
 ):
     """Speed-up over RRT* (log axis, whiskers: CI) against the heatmap's mass near its
-    target, one curve per idea and sampler (points: signal fractions q), one panel per stop
-    rule; the trained networks as labelled stars at their own measured mass. ``settings``:
-    the study's ``eps``, ``level`` and mass ``radius`` (px), named on the figure. Returns it."""
+    target in multiples of a uniform map's (``x_uniform``), one curve per idea's envelope
+    (points: signal fractions q), one panel per stop rule; the trained networks as labelled
+    stars at their own measured mass. ``settings``: the study's ``eps``, ``level`` and mass
+    ``radius`` (px), named on the figure. Returns it."""
     eps = settings["eps"]
     stops = [s for s in QUALITY_STOPS if s in set(curves["stop"])]
     fig, axes = plt.subplots(1, len(stops), figsize=(4.6 * len(stops), 4.2), squeeze=False)
     for ax, stop in zip(axes[0], stops, strict=True):
         sub = curves[(curves["stop"] == stop) & (curves["metric"] == metric)]
         for (idea, conf), rows in sub.groupby(["idea", "configuration"], sort=False):
-            rows = rows.sort_values("heat_mass")
+            rows = rows.dropna(subset=["x_uniform"]).sort_values("x_uniform")
             err = [rows["speedup"] - rows["ci_low"], rows["ci_high"] - rows["speedup"]]
             name = f"{label(conf)}, {IDEA_NAMES.get(idea, idea)}"
             ax.errorbar(
-                rows["heat_mass"],
+                rows["x_uniform"],
                 rows["speedup"],
                 yerr=err,
                 marker="o",
@@ -43,18 +44,22 @@ def quality_figure(
                 capsize=2,
                 label=name,
             )
-        nets = networks[(networks["stop"] == stop) & (networks["metric"] == metric)]
+        nets = (
+            networks
+            if networks.empty
+            else networks[(networks["stop"] == stop) & (networks["metric"] == metric)]
+        )
         # the curves are plain (not informed) samplers: informed networks are not on them
         nets = nets[~nets["configuration"].map(is_informed).astype(bool)].sort_values("speedup")
         placed: list[float] = []  # log10 heights of the labels so far: close ones stacked
         for _, row in nets.iterrows():
-            ax.plot(row["heat_mass"], row["speedup"], "*", ms=12, color="black")
+            ax.plot(row["x_uniform"], row["speedup"], "*", ms=12, color="black")
             y = float(np.log10(row["speedup"]))
             lift = sum(abs(y - other) < 0.05 for other in placed)
             placed.append(y)
             ax.annotate(
                 label(row["configuration"]),
-                (row["heat_mass"], row["speedup"]),
+                (row["x_uniform"], row["speedup"]),
                 fontsize=7,
                 xytext=(4, 4 + 9 * lift),
                 textcoords="offset points",
@@ -62,7 +67,9 @@ def quality_figure(
         ax.axhline(1.0, color="grey", lw=0.8)
         log_ticks(ax.xaxis)
         log_ticks(ax.yaxis)
-        ax.set_xlabel(f"heatmap mass within {settings['radius']:g} px of its target")
+        ax.set_xlabel(
+            f"heatmap mass within {settings['radius']:g} px of its target (x a uniform map's)"
+        )
         ax.set_title(stop_name(stop, eps), fontsize=9)
     axes[0, 0].set_ylabel(f"speed-up over RRT* ({metric.replace('time_to_stop', 'time')})")
     handles, labels = axes[0, 0].get_legend_handles_labels()

@@ -1,84 +1,185 @@
-"""What the sampling-ideas study runs: the oracle study's configurations and the planner-regime
-sweep's cells (settings in :mod:`vnrrt.evaluation.config`: ``oracle``, ``regime``).
+"""What the sampling-ideas study runs (settings in :mod:`vnrrt.evaluation.config`: ``oracle``,
+``regime``).
 
-* **Oracle study** (stage ``oracle@<k>``): on the first ``oracle.random_maps`` random
-  instances, the protocol's configurations (``eval.planners`` with their ``eval.sources``,
-  and informed ones when ``eval.informed``); every oracle of ``oracle.kinds``
-  (:mod:`vnrrt.evaluation.sources`) through the heatmap sampler (NRRT* for path oracles,
-  VNRRT* for the others) and, for vertex oracles, the masked sampler at every tau; and the
-  heatmap-quality curve: the path oracle (NRRT*), the vertex oracle (VNRRT*) and the masked
-  vertex oracle (M-VNRRT* at every tau) mixed with a uniform map at each signal fraction
-  ``oracle.qualities``. All stop rules, paired seeds, one table.
-* **Regime sweep** (stage ``regime@<k>``): the configurations of ``regime.configurations``
-  in every cell of ``regime.etas x regime.radius_modes x regime.goal_radii`` (the planner
-  settings the paper does not give), to within ``planner.eps`` of the A* length and of the
-  exact optimum.
+* **Instances.** The first ``oracle.random_maps`` random test instances, split by base map
+  (:func:`split_instances`): ``oracle.selection_share`` of the maps select, the others
+  evaluate; no base map is in both.
+* **Selection** (stage ``oracle@<k>``): on the selection instances, RRT* and every member of
+  every oracle family (:func:`family_members`): each target of ``oracle.families`` at each blur
+  of ``oracle.sigmas`` and heatmap-draw probability of ``oracle.mixes``, and the path-vertex
+  blend (:func:`vnrrt.evaluation.oracles.blend`) at each ``oracle.blend_weights`` x blur x
+  mix, all through the heatmap sampler; every stop rule, ``oracle.trials`` trials each. Each
+  family's best member per stop rule (the most RRT* iterations saved,
+  :func:`vnrrt.evaluation.sampling_ideas.selection.select`) is its **envelope**.
+* **Evaluation** (stage ``regime@<k>``): on the evaluation instances, in the protocol's cell
+  and in every cell of ``regime.etas x`` radius rules ``x regime.goal_radii``
+  (:func:`regime_cells`): RRT*, ``regime.configurations`` (the trained networks), every
+  envelope and the blend at every weight (at the blend envelope's blur and mix); the
+  protocol's cell also runs the quality curve (each path and vertex envelope diluted to signal
+  fraction ``oracle.qualities``, :func:`vnrrt.evaluation.oracles.dilute`) and every
+  configuration under the other obstacle rule (``+free``).
 """
 
 from __future__ import annotations
 
+import math
+
+import numpy as np
+
 from vnrrt.evaluation.config import Configurations, OracleConfig, RegimeConfig
 from vnrrt.evaluation.keys import ConfigKey
-from vnrrt.evaluation.protocol import STOPS, configurations
-from vnrrt.evaluation.sources import source_name
+from vnrrt.evaluation.oracles import BLEND, OracleSource
+from vnrrt.evaluation.protocol import STOPS
 
-QUALITY_IDEAS = ("oracle_path", "oracle_vertex")  # the oracles of the quality curve
+PROTOCOL = "protocol"  # the regime cell of the protocol's own planner settings
+IDEA_PLANNER = {"path": "nrrt_star"}  # path oracles are NRRT*'s idea; the others VNRRT*'s
+QUALITY_IDEAS = ("path", "vertex")  # the families of the quality curve
 
 
-def oracle_keys(
-    oc: OracleConfig, ev: Configurations, taus: list[float], tau: float
-) -> list[ConfigKey]:
-    """The oracle study's configurations (module doc), each once, in a fixed order; ``taus``
-    every M-VNRRT* threshold, ``tau`` the claims' (``planner.tau``)."""
-    keys = configurations(ev, taus, tau)  # RRT* and the trained networks, as configured
-    for kind in oc.kinds:
-        keys += idea_keys(kind, taus, 1.0)
-    for q in oc.qualities:
-        if q != 1.0:
-            for kind in QUALITY_IDEAS:
-                keys += idea_keys(kind, taus, q)
+def split_instances(
+    instances: list[int], clusters: list[int], share: float, seed: int
+) -> tuple[list[int], list[int]]:
+    """``(selection, evaluation)`` instances: the base maps (``clusters[i]`` of instance
+    ``instances[i]``) shuffled with ``seed``, the first ``share`` of them (at least one, at
+    most all but one) select."""
+    maps = sorted(set(clusters))
+    if len(maps) < 2:
+        raise ValueError(f"the oracle study needs instances of 2 base maps or more, got {maps}")
+    order = np.random.default_rng([seed, 0x5E1EC7]).permutation(len(maps))
+    n = min(max(1, round(share * len(maps))), len(maps) - 1)
+    chosen = {maps[i] for i in order[:n]}
+    sel = [i for i, c in zip(instances, clusters, strict=True) if c in chosen]
+    ev = [i for i, c in zip(instances, clusters, strict=True) if c not in chosen]
+    return sel, ev
+
+
+def member(idea: str, source: OracleSource, mix: float) -> ConfigKey:
+    """The configuration sampling oracle ``source`` with heatmap-draw probability ``mix``."""
+    return ConfigKey(IDEA_PLANNER.get(idea, "vnrrt_star"), mix=mix).with_source(source.text)
+
+
+def family_members(oc: OracleConfig) -> dict[str, list[ConfigKey]]:
+    """``{idea: members}``: every family of ``oracle.families`` and the ``blend`` (module
+    doc), in a fixed order."""
+    out = {}
+    for idea, kinds in oc.families.items():
+        out[idea] = [
+            member(idea, OracleSource(k, s), m) for k in kinds for s in oc.sigmas for m in oc.mixes
+        ]
+    out["blend"] = [
+        member("blend", OracleSource(BLEND, s, w=w), m)
+        for w in oc.blend_weights
+        for s in oc.sigmas
+        for m in oc.mixes
+    ]
+    return out
+
+
+def selection_keys(oc: OracleConfig) -> list[ConfigKey]:
+    """RRT* and every family member (module doc), each once."""
+    keys = [ConfigKey("rrt_star")]
+    for members in family_members(oc).values():
+        keys += members
     return list(dict.fromkeys(keys))
 
 
-def idea_keys(kind: str, taus: list[float], q: float) -> list[ConfigKey]:
-    """How an oracle is sampled: a path oracle through the heatmap sampler (NRRT*), the
-    others through the heatmap sampler (VNRRT*) and the masked one at every tau (M-VNRRT*)."""
-    source = source_name(kind, q)
-    if "path" in kind:
-        return [ConfigKey("nrrt_star").with_source(source)]
-    masked = [ConfigKey("m_vnrrt_star", t).with_source(source) for t in sorted(set(taus))]
-    return [ConfigKey("vnrrt_star").with_source(source), *masked]
+def idea_of(key: ConfigKey, families: dict[str, list[str]]) -> str | None:
+    """The family a configuration's oracle belongs to (``blend`` for the blend; None for
+    networks and RRT*)."""
+    if not key.named_source or not key.source.startswith("oracle_"):
+        return None
+    kind = OracleSource.parse(key.source).kind
+    if kind == BLEND:
+        return "blend"
+    return next((idea for idea, kinds in families.items() if kind in kinds), None)
 
 
-def oracle_counts(oc: OracleConfig) -> dict[tuple[str, str], int]:
-    """Trials per random instance for every stop rule."""
-    return {("random", stop): oc.trials for stop in STOPS}
+def blend_at(key: ConfigKey, w: float) -> ConfigKey:
+    """The blend configuration ``key`` at weight ``w`` (same blur and mix)."""
+    o = OracleSource.parse(key.source)
+    return key.with_source(OracleSource(BLEND, o.sigma, o.q, w).text)
 
 
-def regime_keys(rc: RegimeConfig, sources: dict[str, str]) -> list[ConfigKey]:
-    """``regime.configurations`` as keys, protocol sources resolved by ``sources``
-    (``eval.sources``)."""
-    return [ConfigKey.parse(k, sources) for k in rc.configurations]
+def diluted(key: ConfigKey, q: float) -> ConfigKey:
+    """An oracle configuration ``key`` at signal fraction ``q`` (the quality curve)."""
+    o = OracleSource.parse(key.source)
+    return key.with_source(OracleSource(o.kind, o.sigma, q, o.w).text)
 
 
-def regime_cells(rc: RegimeConfig) -> dict[str, dict]:
-    """``{label: planner overrides}`` of every cell, e.g. ``eta=5 radius=fixed1 goal=eta``:
-    ``{"eta": 5.0, "radius_mode": "fixed", "fixed_radius": 5.0, "goal_radius": None}``."""
-    cells = {}
-    for eta in rc.etas:
-        for mode in rc.radius_modes:
-            for goal in rc.goal_radii:
-                over = {"eta": float(eta), "goal_radius": None if goal is None else float(goal)}
-                if mode == "shrinking":
-                    over["radius_mode"] = "shrinking"
-                else:
-                    over["radius_mode"] = "fixed"
-                    over["fixed_radius"] = float(eta) * int(mode[len("fixed") :])
-                goal_label = "eta" if goal is None else f"{goal:g}"
-                cells[f"eta={eta:g} radius={mode} goal={goal_label}"] = over
+def evaluation_keys(
+    envelopes: dict, oc: OracleConfig, rc: RegimeConfig, ev: Configurations
+) -> dict[str, list[ConfigKey]]:
+    """``{cell: keys}`` of the evaluation (module doc); ``envelopes``: ``{stop: {idea: key
+    text}}`` (:func:`vnrrt.evaluation.sampling_ideas.selection.select`)."""
+    chosen = list(
+        dict.fromkeys(ConfigKey.parse(t) for per in envelopes.values() for t in per.values())
+    )
+    blends = [k for k in chosen if idea_of(k, oc.families) == "blend"]
+    blends = [blend_at(k, w) for k in blends for w in oc.blend_weights]
+    base = [ConfigKey("rrt_star"), *(ConfigKey.parse(t, ev.sources) for t in rc.configurations)]
+    every = list(dict.fromkeys([*base, *chosen, *blends]))
+    quality = [
+        diluted(k, q)
+        for k in chosen
+        if idea_of(k, oc.families) in QUALITY_IDEAS
+        for q in oc.qualities
+        if q != 1.0
+    ]
+    flipped = [k.with_free(not ev.zero_obstacles) for k in [*base, *chosen]]
+    cells = {PROTOCOL: list(dict.fromkeys([*every, *quality, *flipped]))}
+    cells |= {label: every for label in regime_cells(rc)}
     return cells
 
 
-def regime_counts() -> dict[tuple[str, str], int]:
-    """One trial per random instance, to the A* length and to the exact optimum."""
-    return {("random", "optimal"): 1, ("random", "optimal_any_angle"): 1}
+def oracle_counts(oc: OracleConfig) -> dict[tuple[str, str], int]:
+    """Trials per selection instance for every stop rule."""
+    return {("random", stop): oc.trials for stop in STOPS}
+
+
+def evaluation_counts(rc: RegimeConfig, cell: str) -> dict[tuple[str, str], int]:
+    """Trials per evaluation instance: every stop rule in the protocol's cell, the two
+    optimal ones in the others."""
+    stops = STOPS if cell == PROTOCOL else ("optimal", "optimal_any_angle")
+    return {("random", stop): rc.trials for stop in stops}
+
+
+def radius_rules(rc: RegimeConfig) -> list[tuple[str, dict]]:
+    """``(label, planner overrides)`` of each near-radius rule: ``shrinking`` at every
+    ``regime.gamma_factors`` (``shrinking*0.1``), ``fixedK`` (K x eta)."""
+    out = []
+    for mode in rc.radius_modes:
+        if mode == "shrinking":
+            out += [
+                (
+                    "shrinking" if g == 1.0 else f"shrinking*{g:g}",
+                    {"radius_mode": "shrinking", "gamma_factor": float(g)},
+                )
+                for g in rc.gamma_factors
+            ]
+        else:
+            out.append((mode, {"radius_mode": "fixed", "fixed_factor": int(mode[len("fixed") :])}))
+    return out
+
+
+def regime_cells(rc: RegimeConfig) -> dict[str, dict]:
+    """``{label: planner overrides}`` of every cell besides the protocol's, e.g.
+    ``eta=5 radius=shrinking*0.1 goal=inf``: ``{"eta": 5.0, "radius_mode": "shrinking",
+    "gamma_factor": 0.1, "goal_radius": inf}``. An unlimited step with a fixed radius (every
+    node near) is left out."""
+    cells = {}
+    for eta in rc.etas:
+        for name, rule in radius_rules(rc):
+            over = dict(rule)
+            if "fixed_factor" in over:
+                if math.isinf(eta):
+                    continue
+                over["fixed_radius"] = float(eta) * over.pop("fixed_factor")
+            for goal in rc.goal_radii:
+                goal_label = "eta" if goal is None else f"{goal:g}"
+                g = None if goal is None else float(goal)
+                cells[f"eta={eta:g} radius={name} goal={goal_label}"] = {
+                    "eta": float(eta),
+                    "goal_radius": g,
+                    **over,
+                }
+    return cells

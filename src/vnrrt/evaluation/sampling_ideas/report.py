@@ -1,237 +1,337 @@
-"""``reports/sampling_ideas.md``: what each sampling idea can give (oracle heatmaps, the
-heatmap-quality curve, the planner regime) and a conclusion computed from the numbers.
-A renderer of :func:`vnrrt.evaluation.sampling_ideas.summary.analyze_study`'s summary; every
-setting it names (tolerance, CI level, mass radius, blur) comes from the summary's
-``settings``, the run's config."""
+"""``reports/sampling_ideas.md``: what each sampling idea can give (oracle families, their
+envelopes chosen on selection instances and reported on evaluation instances, the
+path-vertex blend, the heatmap-quality curve, the obstacle rule, the planner regime) and a
+conclusion computed from the numbers. A renderer of
+:func:`vnrrt.evaluation.sampling_ideas.summary.analyze_study`'s summary; every setting it names
+(tolerance, CI level, mass radius, the obstacle rule) comes from the summary's ``settings``."""
 
 from __future__ import annotations
 
 import math
 
-import pandas as pd
-
-from vnrrt.evaluation.keys import label, sort_texts
+from vnrrt.evaluation.keys import ConfigKey, label
+from vnrrt.evaluation.sampling_ideas.design import PROTOCOL
 from vnrrt.names import level_name, percent, stop_name
+
+IDEAS = ("path", "vertex", "blend", "control")
+OPTIMAL_STOPS = ("optimal", "optimal_any_angle")
 
 
 def _x(s: dict | None) -> str:
     if not s or s.get("speedup") is None or not math.isfinite(s["speedup"]):
         return "—"
-    return f"{s['speedup']:.2f}x [{s['ci_low']:.2f}, {s['ci_high']:.2f}]"
+    lo, hi = s.get("ci_low"), s.get("ci_high")
+    if lo is None or not math.isfinite(lo):
+        return f"{s['speedup']:.2f}x"
+    return f"{s['speedup']:.2f}x [{lo:.2f}, {hi:.2f}]"
 
 
 def _pct(v) -> str:
     return "—" if v is None or not math.isfinite(v) else f"{100 * v:.1f}%"
 
 
-def oracle_section(oracle: dict, stop: str) -> str:
-    """Per configuration: success, medians, heatmap mass near target, speed-ups over RRT*."""
-    per_key = oracle.get(stop, {})
-    keys = [k for k in sort_texts(per_key) if "@q" not in k]
-    lines = [
-        "| configuration | success | median ms | median iterations | mass near target | "
-        "speed-up, iterations | speed-up, time |",
-        "|" + " --- |" * 7,
-    ]
-    for key in keys:
-        c = per_key[key]
-        lines.append(
-            f"| {label(key)} | {_pct(c['success_rate'])} | {c['median_ms']:.3g} "
-            f"| {c['median_iterations']:.0f} | {_pct(c['heat_mass'])} | "
-            f"{_x(c.get('iterations'))} | {_x(c.get('time_to_stop'))} |"
+def _word(s: dict, better: str, worse: str, same: str) -> str:
+    """``better`` when the CI lies above 1, ``worse`` below, else ``same`` (never a gain
+    for an interval that contains 1)."""
+    if s["ci_low"] is not None and s["ci_low"] > 1:
+        return better
+    if s["ci_high"] is not None and s["ci_high"] < 1:
+        return worse
+    return same
+
+
+def _cell(summary: dict, cell: str, stop: str, text: str | None) -> dict | None:
+    return next(
+        (
+            r
+            for r in summary["cells"]
+            if (r["regime"], r["stop"], r["configuration"]) == (cell, stop, text)
+        ),
+        None,
+    )
+
+
+def _envelope_findings(summary: dict, stop: str, eps: float) -> list[str]:
+    env = summary["selection"]["envelopes"].get(stop, {})
+    rows = {
+        r["idea"]: r for r in summary["envelopes"] if r["regime"] == PROTOCOL and r["stop"] == stop
+    }
+    out = []
+    cells = {i: _cell(summary, PROTOCOL, stop, env.get(i)) for i in IDEAS}
+    said = "; ".join(f"{i} {_x((cells[i] or {}).get('iterations'))}" for i in IDEAS if cells[i])
+    if said:
+        out.append(
+            f"Envelopes ({stop_name(stop, eps)}, the protocol's cell, fewer iterations "
+            f"than RRT*): {said}."
         )
-    return "\n".join(lines)
-
-
-def curve_table(curves: pd.DataFrame, stop: str, metric: str = "iterations") -> str:
-    """The quality curve as a table: rows q, columns the idea/sampler pairs."""
-    sub = curves[(curves["stop"] == stop) & (curves["metric"] == metric)]
-    if sub.empty:
-        return "(not run)"
-    series = list(dict.fromkeys(zip(sub["idea"], sub["configuration"], strict=True)))
-    head = "| q | " + " | ".join(f"{label(c)} [{i}]" for i, c in series) + " |"
-    lines = [head, "|" + " --- |" * (len(series) + 1)]
-    for q in sorted(set(sub["q"]), reverse=True):
-        cells = []
-        for idea, conf in series:
-            row = sub[(sub["q"] == q) & (sub["idea"] == idea) & (sub["configuration"] == conf)]
-            if row.empty:
-                cells.append("—")
-                continue
-            r = row.iloc[0].to_dict()
-            cells.append(f"{_x(r)} (mass {_pct(r['heat_mass'])})")
-        lines.append(f"| {q:g} | " + " | ".join(cells) + " |")
-    return "\n".join(lines)
-
-
-def break_even(curves: pd.DataFrame, stop: str, metric: str = "iterations") -> dict[str, float]:
-    """Per idea/sampler: the smallest heatmap mass near target at which the speed-up's CI
-    lies above 1 at that mass and at every better one (NaN: never)."""
-    out = {}
-    sub = curves[(curves["stop"] == stop) & (curves["metric"] == metric)]
-    for (idea, conf), rows in sub.groupby(["idea", "configuration"], sort=False):
-        rows = rows.sort_values("heat_mass", ascending=False)
-        mass = math.nan
-        for _, r in rows.iterrows():
-            if r["ci_low"] is not None and r["ci_low"] > 1:
-                mass = r["heat_mass"]
-            else:
-                break
-        out[f"{label(conf)} [{idea}]"] = mass
+    if "vertex" in rows:
+        v = rows["vertex"]["iterations"]
+        word = _word(v, "fewer iterations than", "more iterations than", "no clear difference from")
+        out.append(
+            f"Sampling near the turning points (the vertex envelope) needs {word} "
+            f"sampling near the path (the path envelope): {_x(v)} ({stop_name(stop, eps)})."
+        )
     return out
 
 
 def conclusion(summary: dict) -> list[str]:
     """Plain-language findings computed from the summary (module doc)."""
-    oracle, out = summary["oracle"], []
-    eps, radius = summary["settings"]["eps"], summary["settings"]["radius"]
-    for stop in ("optimal", "optimal_any_angle"):
-        out += _oracle_findings(oracle.get(stop, {}), stop_name(stop, eps))
-    curves = pd.DataFrame(summary["curves"])
-    nets = pd.DataFrame(summary["networks"])
-    if not curves.empty:
-        need = break_even(curves, "optimal")
-        said = [
-            f"{k}: {_pct(v)}" if math.isfinite(v) else f"{k}: never at these q"
-            for k, v in need.items()
-        ]
-        out.append(
-            "Heatmap quality needed for a clear gain over RRT* in iterations, "
-            f"{stop_name('optimal', eps)} (mass within {radius:g} px of the target at which "
-            "the CI leaves 1): " + "; ".join(said) + "."
+    st, out = summary["settings"], []
+    eps = st["eps"]
+    for stop in OPTIMAL_STOPS:
+        out += _envelope_findings(summary, stop, eps)
+        w0 = summary["w0"].get(stop)
+        if w0:
+            out.append(
+                f"Does w = 0 (the path oracle) win at every step size ({stop_name(stop, eps)})? "
+                + (
+                    "Yes: no blend with w > 0 needs clearly fewer iterations in any cell."
+                    if w0["w0_wins_everywhere"]
+                    else "No: a blend with w > 0 needs clearly fewer iterations in "
+                    + ", ".join(w0["blend_wins"])
+                    + "."
+                )
+            )
+    for r in summary["networks"]:
+        if r["stop"] != "optimal":
+            continue
+        s = r["iterations"]
+        word = _word(
+            s,
+            "above its family's envelope (the family is incomplete: a member "
+            "this good was not among the oracles)",
+            "below its family's envelope",
+            "no clearly different from its family's envelope",
         )
-    if not nets.empty:
-        sub = nets[(nets["stop"] == "optimal") & (nets["metric"] == "iterations")]
-        placed = [
-            f"{label(r['configuration'])} {_pct(r['heat_mass'])} ({_x(r.to_dict())})"
-            for _, r in sub.iterrows()
-        ]
-        out.append("The trained networks sit at: " + "; ".join(placed) + ".")
+        out.append(
+            f"The trained {label(r['configuration'])} is {word}: {_x(s)} of the "
+            f"{r['idea']} envelope's iterations saved ({stop_name('optimal', eps)})."
+        )
+    out += quality_needed(summary, eps)
     for c in summary["regime_claims"]:
         n = len(c["holds"]) + len(c["reversed"]) + len(c["unclear"])
-        text = (
-            f"{c['claim']} ({stop_name(c['stop'], eps)}): holds in {len(c['holds'])} of {n} "
-            f"regime cells, reversed in {len(c['reversed'])}, unclear in "
-            f"{len(c['unclear'])}"
+        out.append(
+            f"{c['claim']} ({stop_name(c['stop'], eps)}): holds in {len(c['holds'])} of "
+            f"{n} cells, reversed in {len(c['reversed'])}, unclear in {len(c['unclear'])}."
         )
-        if c["holds"]:
-            text += f" (holds: {', '.join(c['holds'][:6])}{' ...' if len(c['holds']) > 6 else ''})"
-        out.append(text + ".")
     return out
 
 
-def _oracle_findings(per: dict, stop_text: str) -> list[str]:
-    """The oracle study's findings at one stop rule (``per``: its cells by key)."""
+def quality_needed(summary: dict, eps: float) -> list[str]:
+    """Per idea: the heatmap quality (mass near the target, x a uniform map's) from which the
+    iteration speed-up's CI lies above 1 at that quality and every better one, from the
+    q > 0 points; "none needed" when q = 0 (a uniform map) already clears."""
     out = []
-    path, vert = per.get("nrrt_star[oracle_path]"), per.get("vnrrt_star[oracle_vertex]")
-    if path and vert and "iterations" in path and "iterations" in vert:
-        p, v = path["iterations"], vert["iterations"]
-        if v["ci_low"] > p["ci_high"]:
-            word = "fewer iterations than"
-        elif v["ci_high"] < p["ci_low"]:
-            word = "more iterations than"
-        else:
-            word = "no clear difference in iterations from"
-        out.append(
-            f"With perfect heatmaps ({stop_text}), sampling near the turning "
-            f"points (vertex oracle, VNRRT*: {_x(v)} over RRT*) needs {word} sampling "
-            f"near the whole path (path oracle, NRRT*: {_x(p)})."
+    for idea in ("path", "vertex"):
+        rows = [
+            r
+            for r in summary["curves"]
+            if r["idea"] == idea and r["stop"] == "optimal" and r["metric"] == "iterations"
+        ]
+        if not rows:
+            continue
+        zero = [r for r in rows if r["q"] == 0.0]
+        if zero and zero[0]["ci_low"] is not None and zero[0]["ci_low"] > 1:
+            out.append(f"{idea} oracle: none needed (a uniform map already clears RRT*).")
+            continue
+        need = None
+        for r in sorted((r for r in rows if r["q"] > 0), key=lambda r: -r["q"]):
+            if r["ci_low"] is None or r["ci_low"] <= 1:
+                break
+            need = r
+        said = (
+            "never at these q"
+            if need is None
+            else (f"{need['x_uniform']:.1f}x a uniform map's mass (q = {need['q']:g})")
         )
-    taut_p = per.get("nrrt_star[oracle_taut_path]")
-    taut_v = per.get("vnrrt_star[oracle_taut_vertex]")
-    if taut_p and taut_v and "iterations" in taut_p and "iterations" in taut_v:
         out.append(
-            f"Read most favourably, with the exact optimum's own segments and turning "
-            f"points ({stop_text}): near the path {_x(taut_p['iterations'])}, near "
-            f"the turning points {_x(taut_v['iterations'])} fewer iterations than RRT*."
-        )
-    masked = {
-        k: c
-        for k, c in per.items()
-        if k.startswith("m_vnrrt_star") and k.endswith("[oracle_vertex]") and "iterations" in c
-    }
-    if masked:
-        best = max(masked, key=lambda k: masked[k]["iterations"]["speedup"])
-        out.append(
-            f"The masked vertex oracle is best at {label(best)}: "
-            f"{_x(masked[best]['iterations'])} fewer iterations than RRT* ({stop_text})."
+            f"Heatmap quality the {idea} idea needs for a clear gain over RRT* in "
+            f"iterations ({stop_name('optimal', eps)}): {said}."
         )
     return out
 
 
-def regime_section(cells: pd.DataFrame, stop: str) -> str:
-    """Speed-up over RRT* per cell (rows) and configuration (columns)."""
-    sub = cells[cells["stop"] == stop] if len(cells) else cells
-    if sub.empty:
-        return "(not run)"
-    confs = list(dict.fromkeys(sub["configuration"]))
+def selection_table(summary: dict, stop: str) -> str:
+    """Per family: members tried, the envelope chosen and its selection speed-up."""
+    sel = summary["selection"]
     lines = [
-        "| regime | " + " | ".join(label(c) for c in confs) + " |",
+        "| family | members | envelope (chosen) | its speed-up on the selection |",
+        "| --- | --- | --- | --- |",
+    ]
+    for idea, cells in sel["speedups"].get(stop, {}).items():
+        chosen = sel["envelopes"].get(stop, {}).get(idea)
+        if chosen:
+            lines.append(f"| {idea} | {len(cells)} | {label(chosen)} | {cells[chosen]:.2f}x |")
+    return "\n".join(lines)
+
+
+def envelope_table(summary: dict, stop: str) -> str:
+    """Per regime cell: each envelope's iteration speed-up over RRT* and the vertex and
+    blend envelopes against the path envelope."""
+    env = summary["selection"]["envelopes"].get(stop, {})
+    vs = {
+        (r["regime"], r["idea"]): r["iterations"] for r in summary["envelopes"] if r["stop"] == stop
+    }
+    head = "| cell | " + " | ".join(IDEAS) + " | vertex / path | blend / path |"
+    lines = [head, "|" + " --- |" * (len(IDEAS) + 3)]
+    for cell in summary["cell_names"]:
+        got = [_x((_cell(summary, cell, stop, env.get(i)) or {}).get("iterations")) for i in IDEAS]
+        if all(g == "—" for g in got):
+            continue
+        lines.append(
+            f"| {cell} | " + " | ".join(got) + f" | {_x(vs.get((cell, 'vertex')))} | "
+            f"{_x(vs.get((cell, 'blend')))} |"
+        )
+    return "\n".join(lines)
+
+
+def blend_table(summary: dict, stop: str) -> str:
+    """Per cell: the blend at each w > 0 against w = 0 (fewer iterations: above 1)."""
+    rows = [b for b in summary["blend"] if b["stop"] == stop]
+    weights = sorted({b["w"] for b in rows})
+    if not weights:
+        return "(not run)"
+    lines = [
+        "| cell | " + " | ".join(f"w = {w:g}" for w in weights) + " |",
+        "|" + " --- |" * (len(weights) + 1),
+    ]
+    for cell in summary["cell_names"]:
+        got = {b["w"]: b["iterations"] for b in rows if b["regime"] == cell}
+        if got:
+            lines.append(f"| {cell} | " + " | ".join(_x(got.get(w)) for w in weights) + " |")
+    return "\n".join(lines)
+
+
+def quality_table(summary: dict, stop: str) -> str:
+    """The quality curve: per idea and q, the heatmap's mass near the target (x uniform)
+    and the iteration speed-up over RRT*."""
+    rows = [r for r in summary["curves"] if r["stop"] == stop and r["metric"] == "iterations"]
+    if not rows:
+        return "(not run)"
+    lines = [
+        "| idea | q | mass near target | x a uniform map's | speed-up, iterations |",
+        "| --- | --- | --- | --- | --- |",
+    ]
+    for r in sorted(rows, key=lambda r: (r["idea"], -r["q"])):
+        x = "—" if r["x_uniform"] is None else f"{r['x_uniform']:.1f}x"
+        lines.append(f"| {r['idea']} | {r['q']:g} | {_pct(r['heat_mass'])} | {x} | {_x(r)} |")
+    return "\n".join(lines)
+
+
+def rule_table(summary: dict, stop: str) -> str:
+    """The protocol cell's configurations under both obstacle rules (speed-up over RRT* under
+    the same rule, iterations)."""
+    rows = [
+        r
+        for r in summary["cells"]
+        if r["regime"] == PROTOCOL
+        and r["stop"] == stop
+        and "iterations" in r
+        and "@q" not in r["configuration"]
+    ]
+    by = {}
+    for r in rows:
+        key = ConfigKey.parse(r["configuration"])
+        by.setdefault(key.with_free(False).text, {})[key.free] = r["iterations"]
+    pairs = {k: v for k, v in by.items() if len(v) == 2}
+    if not pairs:
+        return "(not run)"
+    lines = ["| configuration | every cell | free cells only |", "| --- | --- | --- |"]
+    lines += [f"| {label(k)} | {_x(v[False])} | {_x(v[True])} |" for k, v in pairs.items()]
+    return "\n".join(lines)
+
+
+def regime_section(summary: dict, stop: str) -> str:
+    """Time speed-up over RRT* per cell (rows) and configuration (columns)."""
+    rows = [r for r in summary["regime"] if r["stop"] == stop]
+    if not rows:
+        return "(not run)"
+    confs = list(dict.fromkeys(r["configuration"] for r in rows))
+    lines = [
+        "| cell | " + " | ".join(label(c) for c in confs) + " |",
         "|" + " --- |" * (len(confs) + 1),
     ]
-    for regime, rows in sub.groupby("regime", sort=False):
-        vals = []
-        for c in confs:
-            r = rows[rows["configuration"] == c]
-            vals.append("—" if r.empty else _x(r.iloc[0].to_dict()))
-        lines.append(f"| {regime} | " + " | ".join(vals) + " |")
+    for cell in dict.fromkeys(r["regime"] for r in rows):
+        got = {r["configuration"]: r for r in rows if r["regime"] == cell}
+        lines.append(f"| {cell} | " + " | ".join(_x(got.get(c)) for c in confs) + " |")
     return "\n".join(lines)
+
+
+def _intro(summary: dict, scale: str) -> list[str]:
+    st = summary["settings"]
+    rule = "free cells only" if st["zero_obstacles"] else "every cell, obstacles included"
+    return [
+        f"Made at scale `{scale}`. Oracle heatmaps are built from the labels, not a network "
+        "(`vnrrt.evaluation.oracles`): each idea is a family of oracles over its targets, "
+        "blurs (Gaussian sigma) and heatmap-draw probabilities, and the path-vertex blend H_w "
+        "spans the space between the two ideas. Each family's best member (its envelope) is "
+        f"chosen on {summary['selection']['instances']} selection instances of "
+        f"{len(summary['selection']['maps'])} base maps ({st['selection_share']:.0%} of the maps) "
+        f"and reported on {summary['instances']} evaluation instances of "
+        f"{len(summary['maps'])} other base maps. Speed-ups are paired against RRT* in the same "
+        "cell and under the same obstacle rule: geometric mean of median(RRT*) / "
+        f"median(planner), {level_name(st['level'])} CI from {st['bootstrap']:,} bootstrap "
+        "resamples over base maps. 'Mass near target' is the share of the heatmap's mass "
+        f"within {st['radius']:g} px of its target. The obstacle rule, one for every heatmap "
+        f"source and for the uniform part of every sampler: {rule} (the default; "
+        "`eval.zero_obstacles`: the paper's uniform sampling covers the whole map and its "
+        "networks' heatmaps are used as predicted); the other rule is measured once, in the "
+        "protocol's cell. Back to [the paper comparison](paper_comparison.md).",
+    ]
 
 
 def build_ideas_report(summary: dict, scale: str, figures: list[str]) -> str:
     """The whole ``sampling_ideas.md``; ``figures``: the figure files to show, relative to
     the report."""
-    curves = pd.DataFrame(summary["curves"])
-    cells = pd.DataFrame(summary["regime"])
-    st = summary["settings"]
-    eps = st["eps"]
+    eps = summary["settings"]["eps"]
     parts = [
         "# What each sampling idea can give",
         "",
-        f"Made at scale `{scale}`: {summary['instances']} random test instances (oracle study), "
-        f"{summary['regime_instances']} (regime sweep). Back to "
-        "[the paper comparison](paper_comparison.md).",
-        "",
-        "Oracle heatmaps are built from the labels, not a network "
-        "(`vnrrt.evaluation.sources`): the A* path, its interior vertices (the paper's turning "
-        "points), the vertices with start and goal, start and goal alone, and the segments and "
-        f"turning points of the exact continuous optimum; blurred (Gaussian, sigma "
-        f"{st['sigma']:g} px), zero on obstacles, scaled to a maximum of 1. Speed-ups are "
-        "paired against RRT* on the same instances: geometric mean of median(RRT*) / "
-        f"median(planner), {level_name(st['level'])} CI from {st['bootstrap']:,} bootstrap "
-        "resamples over base maps. 'Mass near target' is the share of the heatmap's mass "
-        f"within {st['radius']:g} px of its target (the metric the networks report).",
+        *_intro(summary, scale),
         "",
         "## Conclusion",
         "",
         *[f"- {line}" for line in conclusion(summary)],
         "",
     ]
-    for stop in ("initial", "optimal", "optimal_any_angle"):
-        if stop in summary["oracle"]:
-            parts += [
-                f"## Oracles, {stop_name(stop, eps)}",
-                "",
-                oracle_section(summary["oracle"], stop),
-                "",
-            ]
+    for stop in ("initial", *OPTIMAL_STOPS):
+        if stop not in summary["selection"]["speedups"]:
+            continue
+        parts += [
+            f"## Envelopes, {stop_name(stop, eps)}",
+            "",
+            "Selection:",
+            "",
+            selection_table(summary, stop),
+            "",
+            "Evaluation (fewer iterations than RRT*, "
+            "and the vertex and blend envelopes against the path envelope):",
+            "",
+            envelope_table(summary, stop),
+            "",
+            "The blend at each w against w = 0:",
+            "",
+            blend_table(summary, stop),
+            "",
+        ]
     parts += [
         "## The heatmap-quality curve",
         "",
-        "Each oracle mixed with a uniform map: signal fraction q of the sampling mass from "
-        "the oracle. Speed-up in iterations over RRT* (mass near the target in brackets).",
+        "Each path and vertex envelope diluted "
+        "towards a uniform map (signal fraction q), in the protocol's cell.",
         "",
     ]
-    for stop in ("optimal", "optimal_any_angle"):
-        parts += [f"### {stop_name(stop, eps)}", "", curve_table(curves, stop), ""]
+    for stop in OPTIMAL_STOPS:
+        parts += [f"### {stop_name(stop, eps)}", "", quality_table(summary, stop), ""]
     parts += [f"![quality curve]({f})" for f in figures if "quality" in f] + [""]
+    parts += ["## The obstacle rule", "", rule_table(summary, "optimal"), ""]
     parts += [
         "## The planner regime",
         "",
-        "Time speed-up over RRT* in the same cell (Steer step eta, near radius, goal "
-        f"radius), to within {percent(eps)} of the reference.",
+        "Time speed-up over RRT* in the same cell (Steer "
+        f"step eta, near-radius rule, goal radius), to within {percent(eps)} of the reference.",
     ]
-    for stop in ("optimal", "optimal_any_angle"):
-        parts += ["", f"### {stop_name(stop, eps)}", "", regime_section(cells, stop)]
+    for stop in OPTIMAL_STOPS:
+        parts += ["", f"### {stop_name(stop, eps)}", "", regime_section(summary, stop)]
     parts += [""] + [f"![regime]({f})" for f in figures if "regime" in f] + [""]
     return "\n".join(parts) + "\n"

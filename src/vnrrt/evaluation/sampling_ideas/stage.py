@@ -1,8 +1,11 @@
 """Entry points of the sampling-ideas study's stages
 (:mod:`vnrrt.evaluation.sampling_ideas.design` says what runs).
 
-* ``oracle@<k>``: part ``k`` of the oracle study -> ``paths.oracle_part(k)``;
-* ``regime@<k>``: part ``k`` of the planner-regime sweep -> ``paths.regime_part(k)``;
+* ``oracle@<k>``: part ``k`` of the selection (every family member on the selection
+  instances) -> ``paths.oracle_part(k)``;
+* ``regime@<k>``: part ``k`` of the evaluation (the envelopes chosen from the merged selection,
+  the networks, RRT*, in every regime cell, on the evaluation instances) ->
+  ``paths.regime_part(k)``;
 * ``ideas``: both merged (checked complete), their statistics (``paths.ideas_summary``),
   ``paths.ideas_report`` and its figures (``paths.ideas_figures``), and the MLflow run.
 """
@@ -15,8 +18,8 @@ from pathlib import Path
 
 from omegaconf import DictConfig
 
-from vnrrt.config import ConfigError, section, sections
-from vnrrt.evaluation.config import Configurations, OracleConfig, RegimeConfig, mask_taus
+from vnrrt.config import ConfigError, check_parts, section, sections
+from vnrrt.evaluation.config import Configurations, OracleConfig, RegimeConfig
 from vnrrt.paths import Paths
 
 log = logging.getLogger(__name__)
@@ -24,66 +27,72 @@ log = logging.getLogger(__name__)
 
 @dataclass(frozen=True)
 class Study:
-    """The typed sections the study's stages read: ``eval``'s configurations, ``oracle``,
-    ``regime`` and the M-VNRRT* thresholds ``taus`` (``planner.taus`` and ``planner.tau``)."""
+    """The typed sections the study's stages read (``regime`` is None in the selection)."""
 
     paths: Paths
-    sources: dict[str, str]  # eval.sources
-    endpoint_radius: float  # eval.endpoint_radius (px)
-    configurations: Configurations | None  # eval's; None where only the sweep runs
+    ev: Configurations
     oracle: OracleConfig
-    regime: RegimeConfig | None  # None where only the oracle study runs
-    taus: list[float]
-    tau: float  # the claims' threshold (planner.tau)
+    regime: RegimeConfig | None
+    seed: int
 
-    def design(self, which: str) -> tuple[list, dict, dict, list[int], int]:
-        """``(keys, counts, cells, parts, instances)`` of the oracle study (``which=
-        'oracle'``) or of the regime sweep; ``cells``: label -> planner overrides."""
+    def instances(self) -> tuple[list[str], list[int], list[int]]:
+        """``(kinds, selection, evaluation)``: the instance kinds and the split (design)."""
+        from vnrrt.data.instances import Instances
+        from vnrrt.evaluation.sampling_ideas.design import split_instances
+
+        inst = Instances(self.paths.instances)
+        kinds, clusters = inst.kinds, inst.arrays["cluster"]
+        chosen = [i for i, k in enumerate(kinds) if k == "random"][: self.oracle.random_maps]
+        sel, ev = split_instances(chosen, [int(clusters[i]) for i in chosen],
+                                  self.oracle.selection_share, self.seed)  # fmt: skip
+        return kinds, sel, ev
+
+    def selection_jobs(self) -> list:
+        """Every job of the selection, in canonical order."""
+        from vnrrt.evaluation.protocol import trial_jobs
+        from vnrrt.evaluation.sampling_ideas.design import oracle_counts, selection_keys
+
+        kinds, sel, _ = self.instances()
+        return trial_jobs(kinds, selection_keys(self.oracle), oracle_counts(self.oracle),
+                          instances=sel)  # fmt: skip
+
+    def envelopes(self) -> tuple[dict, dict]:
+        """``(speed-ups, envelopes)`` of the merged selection (:mod:`.selection`)."""
+        from vnrrt.evaluation.sampling_ideas.design import family_members
+        from vnrrt.evaluation.sampling_ideas.selection import member_speedups, select
+        from vnrrt.evaluation.table import merge_parts
+
+        rows = sum(j.count for j in self.selection_jobs())
+        table = merge_parts(self.paths.oracle, self.oracle.parts, rows)
+        speedups = member_speedups(table, family_members(self.oracle))
+        return speedups, select(speedups)
+
+    def evaluation_jobs(self, envelopes: dict) -> list:
+        """Every job of the evaluation (every cell, the protocol's first), canonical order."""
+        from vnrrt.evaluation.protocol import trial_jobs
         from vnrrt.evaluation.sampling_ideas import design as d
 
-        if which == "oracle":
-            o = self.oracle
-            keys = d.oracle_keys(o, self.configurations, self.taus, self.tau)
-            return keys, d.oracle_counts(o), {"": {}}, o.parts, o.random_maps
-        r = self.regime
-        keys = d.regime_keys(r, self.sources)
-        return keys, d.regime_counts(), d.regime_cells(r), r.parts, r.random_maps
-
-    def jobs(self, which: str) -> list:
-        """Every job of the oracle study or the regime sweep, in canonical order."""
-        from vnrrt.data.instances import Instances
-        from vnrrt.evaluation.protocol import trial_jobs
-
-        keys, counts, cells, _, n = self.design(which)
-        kinds = Instances(self.paths.instances).kinds
-        chosen = [i for i, k in enumerate(kinds) if k == "random"][:n]
-        return trial_jobs(kinds, keys, counts, regimes=tuple(cells), instances=chosen)
+        kinds, _, ev = self.instances()
+        chosen, jobs = ev[: self.regime.random_maps], []
+        for cell, keys in d.evaluation_keys(envelopes, self.oracle, self.regime, self.ev).items():
+            counts = d.evaluation_counts(self.regime, cell)
+            seq = sum(j.count for j in jobs)
+            jobs += trial_jobs(kinds, keys, counts, regimes=(cell,), instances=chosen, seq=seq)
+        return jobs
 
 
 def part_settings(cfg: DictConfig, which: str) -> dict:
     """What stage ``oracle@<k>`` (``which='oracle'``) or ``regime@<k>`` reads, typed (keyed
-    by config section): the oracle study reads ``eval``'s configurations, the sweep
-    ``eval.sources``; both the ``oracle`` section (the oracles' blur, floor and mass radius)
-    and the whole ``planner``."""
-    from vnrrt.config import check_parts
+    by config section); the evaluation also reads the trained networks' heatmaps
+    (``predict.parts``)."""
     from vnrrt.planners.config import PlannerConfig
 
-    oracle_study = which == "oracle"
-    return {
-        "paths": section(cfg, "paths", Paths),
-        "eval": section(cfg, "eval", Configurations)
-        if oracle_study
-        else {
-            "sources": dict(cfg.eval.sources),
-            "endpoint_radius": float(cfg.eval.endpoint_radius),
-        },
-        "oracle": section(cfg, "oracle", OracleConfig),
-        "regime": None if oracle_study else section(cfg, "regime", RegimeConfig),
-        "planner": section(cfg, "planner", PlannerConfig),
-        "predict": {"parts": check_parts(cfg.predict.parts, "predict.parts")},
-        "seed": int(cfg.seed),
-        "workers": int(cfg.workers),
-    }
+    typed = sections(cfg, paths=Paths, eval=Configurations, oracle=OracleConfig)
+    typed |= sections(cfg, planner=PlannerConfig)
+    typed["regime"] = section(cfg, "regime", RegimeConfig) if which == "regime" else None
+    if which == "regime":
+        typed["predict"] = {"parts": check_parts(cfg.predict.parts, "predict.parts")}
+    return typed | {"seed": int(cfg.seed), "workers": int(cfg.workers)}
 
 
 def ideas_settings(cfg: DictConfig) -> dict:
@@ -93,88 +102,93 @@ def ideas_settings(cfg: DictConfig) -> dict:
 
     typed = sections(cfg, paths=Paths, eval=Configurations, oracle=OracleConfig)
     typed |= sections(cfg, regime=RegimeConfig, planner=Rules, stats=StatsConfig)
-    return typed | sections(cfg, logger=LoggerConfig) | {"scale": {"name": str(cfg.scale.name)}}
+    typed |= sections(cfg, logger=LoggerConfig)
+    return typed | {"scale": {"name": str(cfg.scale.name)}, "seed": int(cfg.seed)}
 
 
 def _study(s: dict) -> Study:
-    """The :class:`Study` of a stage's settings (:func:`part_settings`,
-    :func:`ideas_settings`)."""
-    ev, planner = s["eval"], s["planner"]
-    configurations = ev if isinstance(ev, Configurations) else None
-    sources = ev.sources if configurations else ev["sources"]
-    ends = ev.endpoint_radius if configurations else ev["endpoint_radius"]
-    taus = mask_taus(planner.taus, planner.tau)
-    regime = s["regime"]
-    return Study(
-        s["paths"], dict(sources), ends, configurations, s["oracle"], regime, taus, planner.tau
-    )
+    """The :class:`Study` of a stage's settings (:func:`part_settings`, :func:`ideas_settings`)."""
+    return Study(s["paths"], s["eval"], s["oracle"], s["regime"], s["seed"])
 
 
-def _run_part(cfg: DictConfig, part: int, which: str) -> int:
-    """Part ``part`` of the oracle study or the regime sweep; returns the number of trials."""
+def _run(s: dict, jobs: list, configs: dict, out: Path, networks: list[str]) -> int:
+    """Run ``jobs`` (their instances read with the ``networks``' heatmaps) -> ``out``."""
     from vnrrt.data.instances import load
-    from vnrrt.evaluation.protocol import part_jobs
-    from vnrrt.evaluation.sources import is_oracle
     from vnrrt.evaluation.table import write_table
     from vnrrt.evaluation.trials import HeatSettings, run_jobs
 
-    settings = part_settings(cfg, which)
-    s, planner = _study(settings), settings["planner"]
-    _, _, cells, parts, _ = s.design(which)
-    if part not in parts:
-        raise ConfigError(f"part {part} is not in {which}.parts {parts}")
-    jobs = part_jobs(s.jobs(which), part, len(parts))
-    networks = sorted({j.key.source for j in jobs if j.key.source and not is_oracle(j.key.source)})
+    st = _study(s)
+    parts = s.get("predict", {}).get("parts", [0])
     indices = sorted({job.instance for job in jobs})
-    predict_parts = settings["predict"]["parts"]
-    instances, targets = load(s.paths.instances, indices, networks, s.paths.heatmaps, predict_parts)
-    heat = HeatSettings(s.oracle.radius, s.endpoint_radius, targets, s.oracle.sigma, s.oracle.floor)
-    configs = {label: planner.replace(**over) for label, over in cells.items()}
-    log.info(
-        "%s part %d/%d: %d jobs on %d instances", which, part, len(parts), len(jobs), len(instances)
-    )
-    table = run_jobs(jobs, instances, settings["seed"], settings["workers"], configs, heat)
-    out = s.paths.oracle_part(part) if which == "oracle" else s.paths.regime_part(part)
+    instances, targets = load(st.paths.instances, indices, networks, st.paths.heatmaps, parts)
+    oc, ev = st.oracle, st.ev
+    heat = HeatSettings(oc.radius, ev.endpoint_radius, targets, None, oc.floor, ev.zero_obstacles)
+    table = run_jobs(jobs, instances, s["seed"], s["workers"], configs, heat)
     write_table(table, out)
     return len(table)
 
 
+def _part(jobs: list, part: int, parts: list[int], which: str) -> list:
+    from vnrrt.evaluation.protocol import part_jobs
+
+    if part not in parts:
+        raise ConfigError(f"part {part} is not in {which}.parts {parts}")
+    return part_jobs(jobs, part, len(parts))
+
+
 def run_oracle_part(cfg: DictConfig, part: int) -> int:
-    """Stage ``oracle@<part>`` (module doc)."""
-    return _run_part(cfg, part, "oracle")
+    """Stage ``oracle@<part>`` (module doc): returns the number of trials."""
+    s = part_settings(cfg, "oracle")
+    st = _study(s)
+    jobs = _part(st.selection_jobs(), part, st.oracle.parts, "oracle")
+    log.info("selection part %d/%d: %d jobs", part, len(st.oracle.parts), len(jobs))
+    return _run(s, jobs, {"": s["planner"]}, st.paths.oracle_part(part), [])
 
 
 def run_regime_part(cfg: DictConfig, part: int) -> int:
-    """Stage ``regime@<part>`` (module doc)."""
-    return _run_part(cfg, part, "regime")
+    """Stage ``regime@<part>`` (module doc): returns the number of trials."""
+    from vnrrt.evaluation.sampling_ideas.design import PROTOCOL, regime_cells
+    from vnrrt.evaluation.sources import is_oracle
+
+    s = part_settings(cfg, "regime")
+    st, planner = _study(s), s["planner"]
+    _, envelopes = st.envelopes()
+    jobs = _part(st.evaluation_jobs(envelopes), part, st.regime.parts, "regime")
+    cells = {label: planner.replace(**o) for label, o in regime_cells(st.regime).items()}
+    networks = sorted({j.key.source for j in jobs if j.key.source and not is_oracle(j.key.source)})
+    log.info("evaluation part %d/%d: %d jobs", part, len(st.regime.parts), len(jobs))
+    return _run(s, jobs, {PROTOCOL: planner, **cells}, st.paths.regime_part(part), networks)
 
 
 def ideas_tables(settings: dict) -> dict:
-    """The oracle study's and the regime sweep's trial parts merged (checked complete), with
+    """The selection's and the evaluation's trial parts merged (checked complete), with
     stage ``ideas``'s settings: ``{"oracle": table, "regime": table}``."""
     from vnrrt.evaluation.table import merge_parts
 
-    s, tables = _study(settings), {}
-    for which in ("oracle", "regime"):
-        folder = s.paths.oracle if which == "oracle" else s.paths.regime
-        rows = sum(j.count for j in s.jobs(which))
-        tables[which] = merge_parts(folder, s.design(which)[3], rows)
-    return tables
+    st = _study(settings)
+    _, envelopes = st.envelopes()
+    rows = sum(j.count for j in st.selection_jobs())
+    oracle = merge_parts(st.paths.oracle, st.oracle.parts, rows)
+    rows = sum(j.count for j in st.evaluation_jobs(envelopes))
+    return {"oracle": oracle, "regime": merge_parts(st.paths.regime, st.regime.parts, rows)}
 
 
 def ideas_summary(tables: dict, settings: dict) -> dict:
     """The study's statistics (:func:`.summary.analyze_study`) of the merged ``tables``
     with stage ``ideas``'s settings, which the summary records (``settings``)."""
     from vnrrt.evaluation.paper_tables import claim_pairs, load_paper_tables
-    from vnrrt.evaluation.protocol import configurations
-    from vnrrt.evaluation.sampling_ideas.summary import analyze_study
+    from vnrrt.evaluation.sampling_ideas.summary import analyze_study, as_json
+    from vnrrt.io import read_json
 
-    s, rules, st = _study(settings), settings["planner"], settings["stats"]
-    networks = [k.text for k in configurations(s.configurations, s.taus, s.tau) if k.source]
-    pairs = claim_pairs(load_paper_tables(s.paths.paper_tables))
-    shown = {"eps": rules.eps, "level": st.level, "bootstrap": st.bootstrap}
-    shown |= {"radius": s.oracle.radius, "sigma": s.oracle.sigma, "floor": s.oracle.floor}
-    return analyze_study(tables["oracle"], tables["regime"], networks, pairs, shown)
+    st, rules, stats = _study(settings), settings["planner"], settings["stats"]
+    pairs = claim_pairs(load_paper_tables(st.paths.paper_tables))
+    shown = {"eps": rules.eps, "level": stats.level, "bootstrap": stats.bootstrap}
+    shown |= {"radius": st.oracle.radius, "floor": st.oracle.floor}
+    shown |= {"zero_obstacles": st.ev.zero_obstacles, "selection_share": st.oracle.selection_share}
+    predict = read_json(st.paths.predict_metrics)["networks"]
+    study = {"oracle": st.oracle, "regime": st.regime, "ev": st.ev,
+             "targets": {n: m["target"] for n, m in predict.items()}}  # fmt: skip
+    return as_json(analyze_study(tables, study, pairs, shown))
 
 
 def ideas_text(summary: dict, settings: dict) -> str:
@@ -230,12 +244,11 @@ def save_figures(paths: Paths, summary: dict) -> list[Path]:
     from vnrrt.viz.ideas import save_quality, save_regime
 
     written = figure_files(paths, summary)
-    curves, nets = pd.DataFrame(summary["curves"]), pd.DataFrame(summary["networks"])
+    curves, nets = pd.DataFrame(summary["curves"]), pd.DataFrame(summary["placed"])
     sweep = pd.DataFrame(summary["regime"])
     for path in written:
         if path.name == "quality_curve.png":
             save_quality(path, curves, nets, summary["settings"])
         else:
-            stop = path.stem.removeprefix("regime_")
-            save_regime(path, sweep, stop, summary["settings"])
+            save_regime(path, sweep, path.stem.removeprefix("regime_"), summary["settings"])
     return written
