@@ -5,7 +5,7 @@ import pytest
 from scipy import stats
 
 from vnrrt.grid import GridError
-from vnrrt.planners import draw, heatmap_sampler, make_sampler, uniform_sampler
+from vnrrt.planners import PlannerConfig, draw, heatmap_sampler, make_sampler, uniform_sampler
 
 N = 200_000
 
@@ -67,8 +67,8 @@ def test_masked_never_below_tau(heat, tau):
 
 
 def test_masked_falls_back_to_uniform_when_empty(heat):
-    s = make_sampler("m_vnrrt_star", heat.shape, heat, tau=2.0)
-    assert s.fallback_uniform and s.mix == 0.0
+    s = make_sampler("m_vnrrt_star", heat.shape, heat, PlannerConfig(tau=2.0))
+    assert s.fallback_uniform and s.draw_mix == 0.0 and s.mix == 0.5 and s.tau == 2.0
     assert not make_sampler("vnrrt_star", heat.shape, heat).fallback_uniform
 
 
@@ -85,3 +85,4 @@ def test_same_seed_same_draws(heat):
 def test_bad_heatmaps_are_refused(bad):
     with pytest.raises(GridError):
         heatmap_sampler(bad, (9, 11))
+

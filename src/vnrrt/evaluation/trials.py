@@ -102,6 +102,8 @@ def run_job(
     spec, stop, config = job.spec, job.stop, configs[job.regime]
     if spec.informed:
         config = config.replace(informed=True)
+    if spec.tau is not None:
+        config = config.replace(tau=spec.tau)
     warmup()
     heatmap, mass = None, math.nan
     if spec.source is not None:
@@ -109,7 +111,7 @@ def run_job(
         mask = oracle.target_mask(inst, source_target(spec.source, heat))
         mass = oracle.mass_near(heatmap, mask, heat.radius)
     tick = time.perf_counter()
-    sampler = make_sampler(spec.planner, inst.grid.shape, heatmap, spec.tau, config.mix)
+    sampler = make_sampler(spec.planner, inst.grid.shape, heatmap, config)
     setup = time.perf_counter() - tick
     ref = inst.reference(stop)
     milestones = tuple(f * ref for f in CONVERGENCE_FACTORS) if stop != "initial" else ()

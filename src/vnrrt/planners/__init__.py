@@ -3,7 +3,7 @@
 Entry point: :func:`plan`. Depends only on :mod:`vnrrt.grid` and :mod:`vnrrt.search`.
 """
 
-from vnrrt.planners.api import make_sampler, plan, warmup
+from vnrrt.planners.api import Planner, make_sampler, plan, warmup
 from vnrrt.planners.collision import path_free, point_free, polyline_length, segment_free
 from vnrrt.planners.config import PLANNERS, PlannerConfig, PlannerConfigError
 from vnrrt.planners.reference import (
@@ -21,6 +21,7 @@ __all__ = [
     "PLANNERS",
     "Milestone",
     "PlanResult",
+    "Planner",
     "PlannerConfig",
     "PlannerConfigError",
     "Sampler",

@@ -20,7 +20,7 @@ class PlannerConfigError(ValueError):
     """A planner setting is invalid; the message names it."""
 
 
-@dataclass
+@dataclass(frozen=True)
 class PlannerConfig:
     """RRT* core, samplers, stop rules and budgets (paper, Background and VertexNet RRT*).
 
@@ -35,7 +35,7 @@ class PlannerConfig:
             collision-free straight segment; ``None`` means ``eta``; ``.inf``: any node
             that sees the goal.
         mix: probability of a heatmap draw in NRRT*/VNRRT*/M-VNRRT* (Algorithm 2: 0.5).
-        tau: default mask threshold of M-VNRRT* when ``plan`` gets none.
+        tau: mask threshold of M-VNRRT* (pixels with heatmap value below it get no weight).
         taus: thresholds evaluated for M-VNRRT* (paper: 0.5, 0.9, 0.99).
         eps: stop rule ``optimal``: best cost <= (1 + eps) x reference length.
         reference: ``'astar'`` (paper: 8-connected A* length), ``'any_angle'`` (the exact
@@ -53,6 +53,10 @@ class PlannerConfig:
             free it is the optimum and the run ends at once. Off in the paper's protocol.
         max_iterations, max_seconds: budgets; hitting one is a recorded failure.
         trace_capacity: most points kept in the sparse cost-versus-iteration trace.
+
+    Frozen: a config is changed by :meth:`replace`, which validates the copy, so a config
+    that passed :meth:`validate` stays valid (the check is remembered, and repeated calls
+    cost nothing).
     """
 
     eta: float = 10.0
@@ -74,6 +78,8 @@ class PlannerConfig:
 
     def validate(self) -> None:
         """Raise :class:`PlannerConfigError` naming the first invalid value."""
+        if self.__dict__.get("_valid"):
+            return
         for name in ("eta", "fixed_radius", "max_seconds"):
             v = getattr(self, name)
             self._check(name, _finite(v) and v > 0, "> 0")
@@ -98,6 +104,7 @@ class PlannerConfig:
         self._check("trace_capacity", ok, "an integer >= 2")
         self._check("tau", _finite(self.tau), "finite")
         self._check("taus", all(_finite(t) for t in self.taus), "finite values")
+        object.__setattr__(self, "_valid", True)  # not a field: eq, repr and replace ignore it
 
     def _check(self, name: str, ok: bool, why: str) -> None:
         if not ok:

@@ -273,6 +273,15 @@ def connect_goal(occ, tree, counters, stack, p, new):
 
 
 @njit(cache=True)
+def straight_cost(occ, sx, sy, gx, gy):
+    """The cost of the goal joined to a root at the start when the start-goal segment is
+    free: the distance as :func:`connect_goal` computes it (bit for bit); -1 when blocked."""
+    if not segment_free(occ, sx, sy, gx, gy):
+        return -1.0
+    return 0.0 + math.hypot(gx - sx, gy - sy)
+
+
+@njit(cache=True)
 def record(counters, tree, trace, milestones):
     """Append to the sparse trace; return True when the best cost passed a milestone.
 

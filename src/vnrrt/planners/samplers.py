@@ -15,13 +15,15 @@ Informed sampling (:func:`informed_point`, used by the core once a solution exis
 ``informed`` is set) draws the same way but inside the ellipse of the points through which a
 shorter path can run.
 
-If no positive weight is left, the sampler falls back to uniform (``mix = 0``) and sets
-``fallback_uniform``. Randomness comes from a xoshiro256** generator whose 4-word
-``uint64`` state is seeded with :class:`numpy.random.SeedSequence`; no global state.
+If no positive weight is left, the sampler falls back to uniform (no heatmap draws) and sets
+``fallback_uniform``. Randomness comes from a xoshiro256** generator
+whose 4-word ``uint64`` state is seeded with :class:`numpy.random.SeedSequence`; no global
+state.
 """
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -62,16 +64,17 @@ def next_double(s: np.ndarray) -> float:
 
 @dataclass(frozen=True)
 class Sampler:
-    """A sampling distribution over an ``(H, W)`` map.
+    """A sampling distribution over an ``(H, W)`` map, and the settings it was built with.
 
     Attributes:
         kind: ``'uniform'``, ``'heatmap'`` or ``'masked'``.
-        mix: probability of a heatmap draw (0 for uniform or after a fallback).
+        mix: the probability of a heatmap draw it was built with (0 for uniform).
         cdf: ``(H*W,)`` float64 cumulative weights over flat pixels ``y * W + x``
-            (empty for uniform).
+            (empty for uniform or after a fallback).
         last: index of the last pixel with positive weight (-1 for uniform).
         shape: ``(H, W)`` of the map.
         fallback_uniform: True when a heatmap sampler had no positive weight left.
+        tau: the mask threshold of a masked sampler (None for the other kinds).
     """
 
     kind: str
@@ -80,11 +83,23 @@ class Sampler:
     last: int
     shape: tuple[int, int]
     fallback_uniform: bool = False
+    tau: float | None = None
+
+    @property
+    def draw_mix(self) -> float:
+        """Probability that a sample is a heatmap draw: ``mix``, or 0 without weights."""
+        return 0.0 if self.fallback_uniform or self.last < 0 else self.mix
 
 
 def uniform_sampler(shape: tuple[int, int]) -> Sampler:
     """Uniform sampler over the ``(H, W)`` map."""
-    return Sampler("uniform", 0.0, np.zeros(0), -1, (int(shape[0]), int(shape[1])))
+    return _uniform(int(shape[0]), int(shape[1]))
+
+
+@functools.lru_cache(maxsize=64)
+def _uniform(h: int, w: int) -> Sampler:
+    """One uniform sampler per map shape (it holds no weights: nothing to change)."""
+    return Sampler("uniform", 0.0, np.zeros(0), -1, (h, w))
 
 
 def heatmap_sampler(
@@ -110,12 +125,12 @@ def heatmap_sampler(
     if not 0.0 <= mix <= 1.0:
         raise ValueError(f"mix must be in [0, 1], got {mix}")
     weights = hm if tau is None else np.where(hm >= tau, hm, 0.0)
-    kind = "heatmap" if tau is None else "masked"
+    kind, tau = ("heatmap", None) if tau is None else ("masked", float(tau))
     flat = weights.ravel()
     positive = np.flatnonzero(flat > 0)
     if positive.size == 0:
-        return Sampler(kind, 0.0, np.zeros(0), -1, tuple(shape), fallback_uniform=True)
-    return Sampler(kind, float(mix), np.cumsum(flat), int(positive[-1]), tuple(shape))
+        return Sampler(kind, float(mix), np.zeros(0), -1, tuple(shape), True, tau)
+    return Sampler(kind, float(mix), np.cumsum(flat), int(positive[-1]), tuple(shape), False, tau)
 
 
 @njit(cache=True, inline="always")
@@ -227,7 +242,7 @@ def draw(sampler: Sampler, n: int, seed=0, ellipse=None) -> np.ndarray:
         int(n),
         h,
         w,
-        sampler.mix,
+        sampler.draw_mix,
         cdf,
         max(sampler.last, 0),
         ellipse is not None,
