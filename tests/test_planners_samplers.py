@@ -86,3 +86,40 @@ def test_bad_heatmaps_are_refused(bad):
     with pytest.raises(GridError):
         heatmap_sampler(bad, (9, 11))
 
+
+@pytest.mark.parametrize(
+    ("weights", "why"),
+    [
+        ([1e308, 0.5e308, 1e308], "the raw total overflows: every draw landed in the last pixel"),
+        ([0.6e308] * 5 + [0.0], "the raw total overflows midway"),
+        ([5e-324, 5e-324, 5e-324], "subnormal weights: the draw rounded to a multiple of one"),
+    ],
+)
+def test_numerically_hostile_weights_are_drawn_in_proportion(weights, why):
+    """Finite weights whose total overflows (or is subnormal) are scaled by a power of two
+    before they are summed: the pixel frequencies follow the weights' proportions."""
+    hm = np.array([weights], dtype=np.float64)
+    s = heatmap_sampler(hm, hm.shape, mix=1.0)
+    assert np.isfinite(s.cdf).all() and s.cdf[-1] > 0.5, why
+    counts = pixel_counts(draw(s, 60_000, seed=11), hm.shape)
+    share = hm.ravel() / hm.ravel().max()  # the proportions, computed without overflow
+    pos = share > 0
+    assert counts[~pos].sum() == 0
+    expected = share[pos] / share[pos].sum() * counts.sum()
+    assert stats.chisquare(counts[pos], expected).pvalue > 1e-3, why
+
+
+@pytest.mark.parametrize("tau", [None, 0.5, 0.9])
+def test_probability_maps_keep_their_draws_bit_for_bit(tau):
+    """A probability map (a network's float32 sigmoid output, values in [0, 1]) is summed as
+    it is: the cdf equals the plain cumulative sum of its weights, so the draws of every
+    existing seed are unchanged by the scaling of hostile weights."""
+    rng = np.random.default_rng(4)
+    logits = rng.normal(-3.0, 3.0, (200, 200))
+    hm = (1 / (1 + np.exp(-logits))).astype(np.float32)
+    s = heatmap_sampler(hm, hm.shape, mix=0.5, tau=tau)
+    flat = hm.astype(np.float64).ravel()
+    raw = np.cumsum(flat if tau is None else np.where(flat >= tau, flat, 0.0))
+    assert np.array_equal(s.cdf, raw) and s.cdf[-1] == raw[-1]
+    ones = heatmap_sampler(np.ones((200, 200)), (200, 200))
+    assert np.array_equal(ones.cdf, np.arange(1.0, 40_001.0))  # max 1: not rescaled either

@@ -16,7 +16,8 @@ Informed sampling (:func:`informed_point`, used by the core once a solution exis
 shorter path can run.
 
 If no positive weight is left, the sampler falls back to uniform (no heatmap draws) and sets
-``fallback_uniform``. Randomness comes from a xoshiro256** generator
+``fallback_uniform``. Huge or tiny weights are scaled by a power of two before they are summed
+(the draws stay those of the given weights). Randomness comes from a xoshiro256** generator
 whose 4-word ``uint64`` state is seeded with :class:`numpy.random.SeedSequence`; no global
 state.
 """
@@ -70,7 +71,8 @@ class Sampler:
         kind: ``'uniform'``, ``'heatmap'`` or ``'masked'``.
         mix: the probability of a heatmap draw it was built with (0 for uniform).
         cdf: ``(H*W,)`` float64 cumulative weights over flat pixels ``y * W + x``
-            (empty for uniform or after a fallback).
+            (empty for uniform or after a fallback), scaled by a power of two when the raw
+            total would overflow or lose precision (:func:`heatmap_sampler`).
         last: index of the last pixel with positive weight (-1 for uniform).
         shape: ``(H, W)`` of the map.
         fallback_uniform: True when a heatmap sampler had no positive weight left.
@@ -126,11 +128,29 @@ def heatmap_sampler(
         raise ValueError(f"mix must be in [0, 1], got {mix}")
     weights = hm if tau is None else np.where(hm >= tau, hm, 0.0)
     kind, tau = ("heatmap", None) if tau is None else ("masked", float(tau))
-    flat = weights.ravel()
+    flat = _in_range(weights.ravel())
     positive = np.flatnonzero(flat > 0)
     if positive.size == 0:
         return Sampler(kind, float(mix), np.zeros(0), -1, tuple(shape), True, tau)
-    return Sampler(kind, float(mix), np.cumsum(flat), int(positive[-1]), tuple(shape), False, tau)
+    cdf = np.cumsum(flat)
+    if not math.isfinite(cdf[-1]):  # unreachable after _in_range; never sample from it
+        raise GridError(f"heatmap weights sum to {cdf[-1]}, not a finite total")
+    return Sampler(kind, float(mix), cdf, int(positive[-1]), tuple(shape), False, tau)
+
+
+SAFE_TOP = 2.0**960  # weights whose total stays within [2^-960, 2^960] are summed as given
+
+
+def _in_range(flat: np.ndarray) -> np.ndarray:
+    """``flat`` (finite, >= 0) scaled by a power of two when its total would overflow or
+    come near the subnormal range, so that the largest weight lies in [0.5, 1). A power of
+    two scales every sum exactly, so the draws are those of the given weights; weights whose
+    total stays in the safe range (every probability map) are returned as they are, and
+    their draws are bit-identical to an unscaled cumulative sum."""
+    top = float(flat.max()) if flat.size else 0.0
+    if top == 0.0 or (top >= 1.0 / SAFE_TOP and top * flat.size <= SAFE_TOP):
+        return flat
+    return np.ldexp(flat, -math.frexp(top)[1])
 
 
 @njit(cache=True, inline="always")
