@@ -18,8 +18,8 @@ shorter path can run.
 If no positive weight is left, the sampler falls back to uniform (no heatmap draws) and sets
 ``fallback_uniform``. Huge or tiny weights are scaled by a power of two before they are summed
 (the draws stay those of the given weights). Randomness comes from a xoshiro256** generator
-whose 4-word ``uint64`` state is seeded with :class:`numpy.random.SeedSequence`; no global
-state.
+whose 4-word ``uint64`` state is seeded as :class:`numpy.random.SeedSequence` seeds it
+(:func:`vnrrt.planners.seeding.rng_state`); no global state.
 """
 
 from __future__ import annotations
@@ -32,16 +32,9 @@ import numpy as np
 from numba import njit
 
 from vnrrt.grid import GridError
+from vnrrt.planners.seeding import rng_state
 
 _INV_2_53 = 1.0 / 9007199254740992.0
-
-
-def rng_state(seed) -> np.ndarray:
-    """Fresh xoshiro256** state ``(4,)`` uint64 derived from ``seed`` (int or int tuple)."""
-    state = np.random.SeedSequence(seed).generate_state(4, dtype=np.uint64)
-    if not state.any():  # the all-zero state is the one invalid xoshiro state
-        state[0] = 1
-    return state
 
 
 @njit(cache=True, inline="always")
