@@ -24,6 +24,7 @@ from vnrrt.planners import (
     plan,
     uniform_sampler,
 )
+from vnrrt.planners import tree as nodes
 from vnrrt.planners.api import warmup
 from vnrrt.planners.run import FIRST_CAPACITY
 from vnrrt.planners.samplers import HEATMAP_TRIES, rng_state
@@ -231,9 +232,9 @@ def test_tree_memory_follows_the_work_done_not_the_budget(monkeypatch):
     up to the budget (+ root and goal)."""
     warmup()  # its own small runs first
     sizes = []
-    new_tree, enlarge = core.new_tree, core.enlarge
-    monkeypatch.setattr(core, "new_tree", lambda c, *a: sizes.append(c) or new_tree(c, *a))
-    monkeypatch.setattr(core, "enlarge", lambda t, c: sizes.append(c) or enlarge(t, c))
+    new_tree, enlarge = nodes.new_tree, nodes.enlarge
+    monkeypatch.setattr(nodes, "new_tree", lambda c, *a: sizes.append(c) or new_tree(c, *a))
+    monkeypatch.setattr(nodes, "enlarge", lambda t, c: sizes.append(c) or enlarge(t, c))
     fm = named_map("cluttered", 200)
     s, g = fm.starts[0] + 0.5, fm.goals[0] + 0.5
     r = plan(fm.grid, s, g, config=PlannerConfig(max_iterations=10**9), seed=0)

@@ -126,7 +126,8 @@ def _seed(seed) -> None:
 class Planner:
     """One of the paper's RRT* variants set up for one map, as OMPL's ``setup()``: the grid
     validated, the sampler built and the settings checked once; :meth:`solve` answers a
-    query (start, goal, stop rule, seed) at a time.
+    query (start, goal, stop rule, seed) at a time, reusing the tree's arrays from one query
+    to the next (so one solve at a time: not for concurrent use from several threads).
 
     Args:
         grid: ``(H, W)`` bool/int occupancy, nonzero = obstacle, indexed ``grid[y, x]``; a
@@ -165,6 +166,9 @@ class Planner:
         else:
             check_sampler(sampler, planner, self.occ.shape, self.config)
         self.sampler = sampler
+        cfg = self.config
+        budget = run.Budget(cfg.max_iterations, cfg.max_seconds, cfg.trace_capacity)
+        self._work = run.Workspace(self.occ.shape, max(cfg.eta / 2, 1.0), budget)
 
     @functools.cached_property
     def draws(self) -> core.Draws:
@@ -241,11 +245,9 @@ class Planner:
             -1.0, 0.0)  # fmt: skip
         if d >= 0 and (query.target is None or d <= query.target):
             return run.straight_result(self.planner, query, d, spent)
-        cfg = self.config
-        budget = run.Budget(cfg.max_iterations, cfg.max_seconds, cfg.trace_capacity)
         return run.search(self.occ, query, planner=self.planner, params=self._params(query),
-                          draws=self.draws, rng=rng_state(seed), budget=budget, straight=d >= 0,
-                          spent=spent)  # fmt: skip
+                          draws=self.draws, rng=rng_state(seed), work=self._work,
+                          straight=d >= 0, spent=spent)  # fmt: skip
 
     def _params(self, query: run.Query) -> core.Params:
         """The core's settings of a run (:class:`vnrrt.planners.core.Params`)."""
@@ -260,8 +262,11 @@ class Planner:
             gx=query.goal[0],
             gy=query.goal[1],
             min_spacing=float(cfg.min_spacing),
-            bucket=max(cfg.eta / 2, 1.0),
+            bucket=self._work.bucket,
             informed=bool(cfg.informed),
+            refine=float(cfg.refine),
+            pull_parents=bool(cfg.pull_parents),
+            refine_branches=float(cfg.refine_branches),
         )
 
 

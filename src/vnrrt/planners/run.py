@@ -1,11 +1,12 @@
 """One planner run on validated inputs: the timed region of :meth:`vnrrt.planners.Planner.solve`.
 
 The clock starts before the straight start-goal segment is tested (when ``straight_first``)
-and stops when the stop rule or a budget is met. A free straight segment that meets the
-stop rule is the exact optimum, known after that one segment test: its result (a two-node
-tree) is written after the clock has stopped, like every result. Otherwise the tree grows
-in compiled chunks of :func:`vnrrt.planners.core.grow`, budgets checked between chunks.
-"""
+and stops when the stop rule or a budget is met. The tree's arrays are allocated (or emptied
+for reuse) before it starts, as OMPL's ``setup()`` is outside its ``solve()`` times; growing
+them is inside. A free straight segment that meets the stop rule is the exact optimum, known
+after that one segment test: its result (a two-node tree) is written after the clock has
+stopped, like every result. Otherwise the tree grows in compiled chunks of
+:func:`vnrrt.planners.core.grow`, budgets checked between chunks."""
 
 from __future__ import annotations
 
@@ -16,6 +17,7 @@ from typing import NamedTuple
 import numpy as np
 
 from vnrrt.planners import core
+from vnrrt.planners import tree as nodes
 from vnrrt.planners.collision import polyline_length
 from vnrrt.planners.result import Milestone, PlanResult
 
@@ -50,15 +52,21 @@ class Tree:
     """The state of one growing run: tree, scratch buffers, counters and trace (:mod:`.core`)."""
 
     def __init__(self, capacity: int, shape: tuple[int, int], bucket: float, trace: int):
-        self.tree = core.new_tree(capacity, shape, bucket)
-        self.scratch = core.new_scratch(capacity)
-        self.counters = core.new_counters()
-        self.trace = core.Trace(np.empty(trace, np.int64), np.empty(trace))
+        self.tree = nodes.new_tree(capacity, shape, bucket)
+        self.scratch = nodes.new_scratch(capacity)
+        self.counters = nodes.new_counters()
+        self.trace = nodes.Trace(np.empty(trace, np.int64), np.empty(trace))
+        self._flatten()
+
+    def _flatten(self) -> None:
+        """The arrays as plain tuples, as :func:`vnrrt.planners.core.grow_flat` takes them."""
+        self.flat = tuple(self.tree), tuple(self.scratch), tuple(self.counters), tuple(self.trace)
 
     def enlarge(self, capacity: int) -> None:
         """Room for ``capacity`` nodes, the tree kept."""
-        self.tree = core.enlarge(self.tree, capacity)
-        self.scratch = core.new_scratch(capacity)
+        self.tree = nodes.enlarge(self.tree, capacity)
+        self.scratch = nodes.new_scratch(capacity)
+        self._flatten()
 
     @property
     def capacity(self) -> int:
@@ -68,6 +76,32 @@ class Tree:
         """Whether the goal is in the tree at a cost meeting ``target`` (None: any cost)."""
         g = int(self.counters.goal[0])
         return g >= 0 and (target is None or self.tree.cost[g] <= target)
+
+    def reset(self) -> None:
+        """Empty the tree, its arrays kept (a node's fields are written when it is added)."""
+        for count in self.counters:
+            count[0] = 0
+        self.counters.goal[0] = -1
+        self.tree.head.fill(-1)
+
+
+class Workspace:
+    """The arrays of the runs of one :class:`vnrrt.planners.Planner` on one map: allocated by
+    the first run (``FIRST_CAPACITY`` nodes, grown as needed), emptied and reused by the next
+    ones. One run at a time."""
+
+    def __init__(self, shape: tuple[int, int], bucket: float, budget: Budget):
+        self.shape, self.bucket, self.budget = shape, bucket, budget
+        self._tree: Tree | None = None
+
+    def fresh(self) -> Tree:
+        """An empty tree (newly allocated the first time)."""
+        if self._tree is None:
+            capacity = min(self.budget.max_iterations + 2, FIRST_CAPACITY)
+            self._tree = Tree(capacity, self.shape, self.bucket, self.budget.trace_capacity)
+        else:
+            self._tree.reset()
+        return self._tree
 
 
 def stop_bounds(query: Query) -> np.ndarray:
@@ -125,22 +159,21 @@ def search(
     params: core.Params,
     draws: core.Draws,
     rng: np.ndarray,
-    budget: Budget,
+    work: Workspace,
     straight: bool,
     spent: float = 0.0,
 ) -> PlanResult:
-    """Grow a tree from the start until the stop rule or a budget is met; ``straight``: the
-    start-goal segment is known to be free (the goal joins the root at once); ``spent``:
-    seconds of the run before this call (the straight-segment test)."""
-    t0 = time.perf_counter() - spent
+    """Grow a tree (in ``work``) from the start until the stop rule or a budget is met;
+    ``straight``: the start-goal segment is known to be free (the goal joins the root at
+    once); ``spent``: seconds of the run before this call (the straight-segment test)."""
     stops = stop_bounds(query)
-    run = Tree(min(budget.max_iterations + 2, FIRST_CAPACITY), occ.shape, params.bucket,
-               budget.trace_capacity)  # fmt: skip
-    first = params._replace(goal_radius=math.inf) if straight else params
-    c, tree = run.counters, run.tree
-    core.plant(occ, tree, c, run.scratch.stack, run.trace, first, stops)
+    run = work.fresh()  # allocated (or emptied) before the clock starts, as OMPL's setup()
+    first = tuple(params._replace(goal_radius=math.inf) if straight else params)
+    tree, _, counters, trace = run.flat
+    t0 = time.perf_counter() - spent
+    core.plant_flat(occ, tree, counters, run.scratch.stack, trace, first, stops)
     reason, times, iters = drive(run, occ, draws=draws, params=params, rng=rng, stops=stops,
-                                 target=query.target, budget=budget, t0=t0)  # fmt: skip
+                                 target=query.target, budget=work.budget, t0=t0)  # fmt: skip
     elapsed = time.perf_counter() - t0
     reached = {b: (float(t), int(i)) for b, t, i in zip(stops, times, iters, strict=True)}
     return result(run, planner, query, reason=reason, reached=reached, elapsed=elapsed)
@@ -157,7 +190,7 @@ def drive(
     target: float | None,
     budget: Budget,
     t0: float,
-) -> tuple[str, np.ndarray, np.ndarray]:
+) -> tuple[str, list[float], list[int]]:
     """Grow the planted tree in compiled chunks until the stop rule or a budget is met.
 
     Returns ``(stop_reason, times, iterations)``: per entry of ``stops`` (decreasing cost
@@ -165,13 +198,14 @@ def drive(
     first reached (NaN / -1: never).
     """
     c = run.counters
-    times, iters = np.full(len(stops), math.nan), np.full(len(stops), -1, np.int64)
+    times, iters = [math.nan] * len(stops), [-1] * len(stops)
     chunk, passed, status = FIRST_CHUNK, 0, core.RUNNING
+    draws_t, params_t = tuple(draws), tuple(params)
     while True:
         now = time.perf_counter() - t0
-        times[passed : c.milestone[0]] = now
-        iters[passed : c.milestone[0]] = c.iters[0]
-        passed = c.milestone[0]
+        for m in range(passed, int(c.milestone[0])):
+            times[m], iters[m] = now, int(c.iters[0])
+        passed = int(c.milestone[0])
         if run.solved(target):
             return "solved", times, iters
         if status == core.TREE_FULL:
@@ -183,7 +217,7 @@ def drive(
         if now >= budget.max_seconds:
             return "max_seconds", times, iters
         n = min(chunk, budget.max_iterations - int(c.iters[0]))
-        status = core.grow(occ, run.tree, run.scratch, c, run.trace, rng, draws, stops, params, n)
+        status = core.grow_flat(occ, *run.flat, rng, draws_t, stops, params_t, n)
         chunk = min(2 * chunk, MAX_CHUNK)
 
 
@@ -199,11 +233,12 @@ def result(
     """The :class:`PlanResult` of a finished run; ``reached[bound] = (seconds, iteration)``."""
     c, tree = run.counters, run.tree
     n, g, k = int(c.nodes[0]), int(c.goal[0]), int(c.trace_len[0])
-    path = core.branch(tree.links, tree.pts, g) if g >= 0 else np.zeros((0, 2))
-    trace_it, trace_cost = run.trace.iters[:k].copy(), run.trace.costs[:k].copy()
-    if k and trace_cost[-1] != tree.cost[g]:
-        trace_it = np.append(trace_it, c.iters[0])
-        trace_cost = np.append(trace_cost, tree.cost[g])
+    path = nodes.branch(tree.links, tree.pts, g) if g >= 0 else np.zeros((0, 2))
+    last = k and run.trace.costs[k - 1] != tree.cost[g]  # the final value, when not traced
+    trace_it, trace_cost = np.empty(k + last, np.int64), np.empty(k + last)
+    trace_it[:k], trace_cost[:k] = run.trace.iters[:k], run.trace.costs[:k]
+    if last:
+        trace_it[k], trace_cost[k] = c.iters[0], tree.cost[g]
     first_time, first_iter = reached[math.inf]
     return PlanResult(
         planner=planner,
@@ -226,5 +261,5 @@ def result(
         fallback_uniform=query.fallback_uniform,
         setup_time=query.setup_time,
         tree_points=tree.pts[:n].copy() if query.keep_tree else None,
-        tree_parents=tree.links[:n, core.PARENT].copy() if query.keep_tree else None,
+        tree_parents=tree.links[:n, nodes.PARENT].copy() if query.keep_tree else None,
     )
