@@ -68,6 +68,9 @@ def build(out_dir: Path = BUILD) -> Path:
         tail = "\n".join(done.stderr.strip().splitlines()[-5:])
         raise HarnessError(f"building the OMPL harness failed ({INSTALL}?):\n{tail}")
     tmp.replace(binary)
+    for old in binary.parent.glob("harness-*"):  # builds of earlier sources
+        if old != binary and ".tmp-" not in old.name:
+            old.unlink(missing_ok=True)
     return binary
 
 

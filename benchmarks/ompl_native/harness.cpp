@@ -89,10 +89,12 @@ static ob::PlannerPtr planner_named(const std::string &name, const ob::SpaceInfo
 }
 
 static std::string solve(const Grid &g, std::istringstream &in) {
-    std::string name;
-    double range, sx, sy, gx, gy, bound, limit;
-    if (!(in >> name >> range >> sx >> sy >> gx >> gy >> bound >> limit))
+    std::string name, tok[7];
+    if (!(in >> name >> tok[0] >> tok[1] >> tok[2] >> tok[3] >> tok[4] >> tok[5] >> tok[6]))
         throw std::invalid_argument("solve expects PLANNER RANGE SX SY GX GY BOUND LIMIT");
+    double v[7];
+    for (int i = 0; i < 7; ++i) v[i] = std::stod(tok[i]);  // stod reads "inf" too
+    const double range = v[0], sx = v[1], sy = v[2], gx = v[3], gy = v[4], bound = v[5], limit = v[6];
     if (g.h <= 0) throw std::invalid_argument("no map given before solve");
     const auto t_setup = Clock::now();
     auto space = std::make_shared<ob::RealVectorStateSpace>(2);
