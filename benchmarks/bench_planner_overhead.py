@@ -87,9 +87,9 @@ def main(argv: list[str] | None = None) -> int:
             for key in ratios:
                 ratios[key].append(us[key] / stop)
             tag = " free" if segment_free(g, *s, *e) else ""
-            print(f"{name + tag:<12}{1e6 * us['run']:8.1f}{1e6 * us['solve']:9.1f}"
+            print(f"{name + tag:<15}{1e6 * us['run']:8.1f}{1e6 * us['solve']:9.1f}"
                   f"{1e6 * us['plan']:9.1f}{1e6 * us['setup']:10.1f}"
-                  f"{f'{best} {1e6 * stop:.1f}':>18}{1e6 * setup:10.1f}"
+                  f"{f'{best} {1e6 * stop:.1f}':>22}{1e6 * setup:10.1f}"
                   f"{ratios['plan'][-1]:15.2f}{ratios['solve'][-1]:15.2f}")  # fmt: skip
     for key, label in (("plan", "plan() call"), ("solve", "Planner.solve() call")):
         r = ratios[key]

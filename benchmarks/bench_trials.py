@@ -9,9 +9,10 @@ are not available here: each network source samples the oracle heatmap of its ta
 labels' path for NRRT*, the interior vertices for VNRRT*/M-VNRRT*), so the heatmap planners
 run at the rate of a perfect network. Per trial the stage's wall time (heatmap and sampler
 set-up, the ``plan()`` call, the row) and the planning time alone are both reported; the
-paper-scale cost uses the stage's trial counts (``bench_paper_scale.trials_hours``, the mean
-planning seconds per kind, stop and configuration) scaled by the measured wall / planning
-ratio.
+paper-scale cost takes the paper protocol's jobs (:func:`vnrrt.evaluation.protocol.trial_jobs`
+over its 5 named and ``eval.random_maps`` random instances), each trial at the mean planning
+time measured here for its map kind, stop rule and configuration, scaled by the measured
+wall / planning ratio.
 
     python benchmarks/bench_trials.py [--random-maps 12] [--named-trials 4] [--cluster 64,256]
 """
@@ -23,12 +24,12 @@ import time
 
 import numpy as np
 
-from bench_paper_scale import fmt_time, trial_seconds, trials_hours
+from bench_paper_scale import fmt_time, trial_seconds
 from vnrrt.config import compose, section
 from vnrrt.evaluation.config import EvalConfig
 from vnrrt.evaluation.instances import EvalInstance
 from vnrrt.evaluation.oracle import instance_heatmap
-from vnrrt.evaluation.protocol import planner_specs
+from vnrrt.evaluation.protocol import planner_specs, trial_counts, trial_jobs
 from vnrrt.evaluation.trials import HeatSettings, run_trials
 from vnrrt.maps.config import DataConfig
 from vnrrt.maps.generate import generate_map, map_rng
@@ -65,6 +66,17 @@ def instances(n_random: int, sources: dict[str, str]) -> list[EvalInstance]:
     return out
 
 
+def paper_cost(cfg, specs, table) -> tuple[float, int]:
+    """Planning seconds and trial count of the paper protocol's jobs, each trial at the mean
+    planning time of its (map kind, stop rule, configuration) in ``table``."""
+    ev = section(cfg, "eval", EvalConfig)
+    kinds = ["named"] * len(NAMES) + ["random"] * ev.random_maps
+    rate = trial_seconds(table)
+    jobs = trial_jobs(kinds, specs, trial_counts(ev))
+    seconds = sum(j.count * rate[kinds[j.instance], j.stop, j.spec.key] for j in jobs)
+    return float(seconds), sum(j.count for j in jobs)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--random-maps", type=int, default=12, help="random instances")
@@ -96,16 +108,12 @@ def main() -> None:
     for stop, part in table.groupby("stop"):
         print(f"  {stop}: {len(part):,} trials, planning {1e3 * part['time_to_stop'].mean():.2f}"
               f" ms a trial, success {part['success'].mean():.3f}")  # fmt: skip
-    hours, count, borrowed = trials_hours(trial_seconds(table), 1.0, cfg)
-    hours *= wall / planning  # from planning time to the stage's wall time
-    print(
-        f"paper scale: {count:,} trials, {hours:.1f} core-hours at this rate "
-        f"({count / (hours * 3600):.1f} trials/s per core)"
-    )
-    if borrowed:
-        print(f"  rates borrowed from RRT* for {borrowed}")
+    seconds, count = paper_cost(cfg, specs, table)
+    seconds *= wall / planning  # from planning time to the stage's wall time
+    print(f"paper scale: {count:,} trials, {seconds / 3600:.2f} core-hours at these rates "
+          f"({count / seconds:.1f} trials/s per core)")  # fmt: skip
     for cores in [2, *(int(c) for c in args.cluster.split(","))]:
-        print(f"  on {cores} cores: {fmt_time(hours * 3600 / cores)}")
+        print(f"  on {cores} cores: {fmt_time(seconds / cores)}")
     print(
         f"  (planning-time share of the wall time: {planning / wall:.2f}; "
         f"median trial {1e3 * np.median(table['time_to_stop']):.2f} ms)"

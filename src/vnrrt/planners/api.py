@@ -6,7 +6,8 @@ Coordinates follow :mod:`vnrrt.grid`: ``grid`` is ``(H, W)`` indexed ``grid[y, x
 centres ``(x + 0.5, y + 0.5)`` for dataset instances). Every setting comes from one
 :class:`PlannerConfig` (the M-VNRRT* threshold ``tau`` included). Timings cover the tree
 search only: building the sampler from a heatmap (per map, once; reported as
-``setup_time``), JIT compilation (once per process, :func:`warmup`) and the reference-length
+``setup_time``), allocating the tree's arrays (per planner, reused; as OMPL's ``setup()``),
+seeding, JIT compilation (once per process, :func:`warmup`) and the reference-length
 computation (an oracle, not part of planning) are outside the timed region. With
 ``straight_first``, a free start-goal segment that meets the stop rule is the answer: the run's
 time is that one segment test (:mod:`.run`).
@@ -285,8 +286,16 @@ def plan(
     milestones: tuple[float, ...] = (),
     keep_tree: bool = False,
 ) -> PlanResult:
-    """Plan once: ``Planner(grid, planner, heatmap=, config=, sampler=).solve(start, goal,
-    stop=, reference_length=, seed=, milestones=, keep_tree=)`` (see :class:`Planner`)."""
+    """Plan once from ``start`` to ``goal``: ``Planner(grid, planner, heatmap=heatmap,
+    config=config, sampler=sampler).solve(start, goal, stop=stop, ...)``.
+
+    ``grid`` ``(H, W)`` occupancy (nonzero = obstacle, ``grid[y, x]``); ``start``, ``goal``
+    continuous ``(x, y)`` pixels; ``planner`` one of :data:`PLANNERS` (all but RRT* sample
+    ``heatmap``, or a prebuilt ``sampler``); every setting in ``config`` (default
+    :class:`PlannerConfig`; :data:`FASTEST` our fastest); ``stop`` ``'initial'`` or
+    ``'optimal'`` (cost <= (1 + eps) x ``reference_length``, None: ``config.reference``
+    computed); ``seed`` an int >= 0 or a tuple of them. Arguments and errors: :class:`Planner`
+    and :meth:`Planner.solve`. Returns a :class:`PlanResult`."""
     p = Planner(grid, planner, heatmap=heatmap, config=config, sampler=sampler)
     return p.solve(start, goal, stop=stop, reference_length=reference_length, seed=seed,
                    milestones=milestones, keep_tree=keep_tree)  # fmt: skip
