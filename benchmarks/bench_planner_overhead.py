@@ -63,10 +63,8 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--calls", type=int, default=200, help="calls per map and planner")
     args = ap.parse_args(argv)
-    try:
-        binary = ompl_native.build()
-    except ompl_native.HarnessError as err:
-        print(f"cannot build the native OMPL harness: {err}", file=sys.stderr)
+    binary = ompl_native.build_or_explain()
+    if binary is None:
         return 2
     warmup()
     maps = [m for m in dev_instances() + held_out_instances()

@@ -206,10 +206,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--no-python", action="store_true", help="skip OMPL's Python bindings")
     ap.add_argument("--seed", type=int, default=0)
     args = ap.parse_args(argv)
-    try:
-        binary = ompl_native.build()
-    except ompl_native.HarnessError as err:
-        print(f"cannot build the native OMPL harness: {err}", file=sys.stderr)
+    binary = ompl_native.build_or_explain()
+    if binary is None:
         return 2
     if not args.no_python:
         ompl_python.quiet(args.seed + 1)

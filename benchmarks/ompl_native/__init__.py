@@ -18,6 +18,7 @@ import math
 import os
 import shutil
 import subprocess
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -72,6 +73,16 @@ def build(out_dir: Path = BUILD) -> Path:
         if old != binary and ".tmp-" not in old.name:
             old.unlink(missing_ok=True)
     return binary
+
+
+def build_or_explain() -> Path | None:
+    """:func:`build`, or None after saying on stderr why it failed and how to install what
+    is missing (a benchmark then exits 2)."""
+    try:
+        return build()
+    except HarnessError as err:
+        print(f"cannot build the native OMPL harness: {err}", file=sys.stderr)
+        return None
 
 
 @dataclass(frozen=True)
