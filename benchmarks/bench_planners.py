@@ -1,25 +1,36 @@
-"""Benchmark: this package's planners against OMPL's best on occupancy grids.
+"""Benchmark: our planners against native OMPL (C++) and OMPL's Python bindings, and the floor.
 
-In one process, on the same maps (the five named maps, crafted traps, random test maps of
-the data generator) and start/goal pairs: our best configuration (informed RRT*, the
-straight segment tried first, the goal joined by any node that sees it, Steer step 20 px),
-our paper-setting RRT* (step 10 px), and OMPL's RRTstar, InformedRRTstar and BITstar at
-their default settings and, for the two with a step, at our step ("matched"). Every run
-records, in seconds from the planner's start, the time to its first solution and to a cost
-within 1% of the exact continuous optimum (:func:`vnrrt.planners.any_angle_path`); a run
-stops there or at ``--time-limit`` (then it counts as the limit: medians marked ">=" are
-lower bounds). Per map the median over trials, and the ratio of the best OMPL planner's
-median to ours; overall the median over maps. OMPL checks states with a Python validity
-checker every 0.5 px along motions, so its paths may clip obstacle corners: every final
-path is checked with our exact segment test and the clipping paths are counted (ours: by
-construction none).
+In one process, on the same maps (:mod:`planner_maps`: a development set and a held-out set,
+reported apart) and start/goal pairs, alternating per trial: our best configuration
+(``ours-best``, :data:`vnrrt.planners.FASTEST`: informed, straight segment first, goal joined
+by any node that sees it, Steer step 20 px, path refinement, pulled parents) and our
+paper-setting RRT* (step 10 px); native OMPL 1.5
+(a C++ harness built here against the system's ``libompl-dev``, :mod:`ompl_native`): RRTstar,
+InformedRRTstar, BITstar, ABITstar and AITstar at their defaults and the two RRT* planners at
+our step ("-m", matched); OMPL's Python bindings (:mod:`ompl_python`, a Python validity
+checker): RRTstar, InformedRRTstar and BITstar at defaults and the RRT* two matched. OMPL
+checks motions every 0.5 px and stops itself at its cost threshold, 1.01 x the exact optimum.
 
-    python benchmarks/bench_planners.py [--random 12] [--trials 3] [--time-limit 2]
+Every run records, in seconds from the start of the planner's own timed region (our run;
+OMPL's ``solve()``, its setup apart), the time to its first solution and to a cost within 1%
+of the exact continuous optimum (:func:`vnrrt.planners.any_angle_path`); a run stops there or
+at ``--time-limit`` (a miss counts as the limit: medians marked ">=" are lower bounds).
+``ours-call`` is the whole ``plan()`` call (input checks, setup, seeding and result
+included). Per map: medians over trials and the ratio of the best native OMPL planner's
+median to ours; overall: each planner's median over maps, the ratio of the best OMPL
+planner's (native, then Python) to ours, and the median and worst per-map ratio (for the
+whole call too). The
+floor is the exact visibility-graph solve itself, timed per map. Every path of ours is checked
+with the exact segment test and against the stop rule (exit 1 if one fails); OMPL's paths that
+clip an obstacle corner under that test are counted. Exit 2 when the harness cannot be built.
+
+    python benchmarks/bench_planners.py [--trials 5] [--time-limit 2] [--sets dev,held_out]
 """
 
 from __future__ import annotations
 
 import argparse
+import gc
 import math
 import os
 import sys
@@ -27,224 +38,199 @@ import time
 
 import numpy as np
 
-from vnrrt.maps.config import DataConfig
-from vnrrt.maps.generate import generate_map, largest_free_region, map_rng
-from vnrrt.maps.named import NAMES, named_map
-from vnrrt.planners import any_angle_path, path_free, plan, warmup
-from vnrrt.planners.collision import point_free
+import ompl_native
+import ompl_python
+from planner_maps import dev_instances, held_out_instances
+from vnrrt.planners import FASTEST, PlannerConfig, any_angle_path, path_free, plan, warmup
 
-ETA, BEST_ETA = 10.0, 20.0
-OURS = {
-    "ours-best": dict(informed=True, straight_first=True, goal_radius=math.inf, eta=BEST_ETA),
-    "ours-rrt*": dict(eta=ETA),
-}
-OMPL = ("RRTstar", "InformedRRTstar", "BITstar")
+ETA, BEST_ETA = 10.0, FASTEST.eta
+OURS = {"ours-best": FASTEST, "ours-rrt*": PlannerConfig(eta=ETA)}
+NATIVE = [*ompl_native.PLANNERS, "RRTstar-m", "InformedRRTstar-m"]
+PYTHON = [*ompl_python.PLANNERS, "RRTstar-m", "InformedRRTstar-m"]
 
 
-# --- maps ------------------------------------------------------------------------------------
+def run_ours(g, s, e, exact, seed, config) -> dict:
+    """Our planner to 1% of ``exact``; times of the run and of the whole call (the other
+    planners' garbage collected first, so that its collection is not timed in our call)."""
+    gc.collect()
+    t0 = time.perf_counter()
+    r = plan(g, s, e, stop="optimal", reference_length=exact, seed=seed, config=config)
+    call = time.perf_counter() - t0
+    ok = path_free(g, r.path) and (not r.success or r.cost <= 1.01 * exact + 1e-9)
+    stop = r.time_to_stop if r.success else math.nan
+    return {"first": r.time_to_first, "stop": stop, "call": call if r.success else math.nan,
+            "clipped": not ok}  # fmt: skip
 
 
-def _walls(rng: np.random.Generator, size: int) -> np.ndarray:
-    g = np.zeros((size, size), np.uint8)
-    for i, x in enumerate(np.linspace(0, size, rng.integers(2, 4) + 2)[1:-1].astype(int)):
-        gap = rng.integers(3, 7)  # a narrow gap, 3..6 px
-        y = rng.integers(10, size - 10 - gap)
-        g[:, x : x + 3] = 1
-        g[y : y + gap, x : x + 3] = 0
-        if i % 2:
-            y2 = (y + size // 2) % (size - 20) + 5
-            g[y2 : y2 + 8, x : x + 3] = 0
-    return g
-
-
-def _bug_trap(size: int) -> np.ndarray:
-    """A C around the start at the centre, open to the left, the goal to the right."""
-    g = np.zeros((size, size), np.uint8)
-    g[60:140, 136:140] = 1  # the wall between start and goal
-    g[60:64, 60:140] = 1
-    g[136:140, 60:140] = 1
-    return g
-
-
-def _far_pair(rng, g, min_dist):
-    free = np.argwhere(g == 0)[:, ::-1] + 0.5
-    while True:
-        s, e = free[rng.integers(len(free), size=2)]
-        if math.dist(s, e) >= min_dist and point_free(g, s) and point_free(g, e):
-            return tuple(s), tuple(e)
-
-
-def make_instances(n_random: int, seed: int, size: int = 200) -> list[tuple]:
-    """``(name, grid, start, goal)``: the named maps, crafted traps, random test maps."""
-    out = []
-    for name in NAMES:
-        fm = named_map(name, size)
-        out.append((name, fm.grid, tuple(fm.starts[0] + 0.5), tuple(fm.goals[0] + 0.5)))
-    rng = np.random.default_rng(seed)
-    for k in range(3):
-        g = _walls(rng, size)
-        out.append((f"walls{k}", g, (5.5, size / 2 + 0.5), (size - 5.5, size / 2 + 0.5)))
-    out.append(("bug_trap", _bug_trap(size), (100.5, 100.5), (190.5, 100.5)))
-    empty = np.zeros((size, size), np.uint8)
-    out.append(("empty", empty, (5.5, 5.5), (size - 5.5, size - 5.5)))
-    for i in range(n_random):
-        fm = generate_map(map_rng(seed + 1, i), DataConfig(size=size))
-        outside = (~largest_free_region(fm.grid)).astype(np.uint8)  # start/goal connected
-        s, e = _far_pair(rng, outside, 0.4 * size)
-        out.append((f"random{i}", fm.grid, s, e))
-    return out
-
-
-# --- planners ----------------------------------------------------------------------------------
-
-
-def run_ours(g, start, goal, bound, seed, limit, settings) -> dict:
-    r = plan(
-        g,
-        start,
-        goal,
-        "rrt_star",
-        stop="optimal",
-        reference_length=bound / 1.01,
-        seed=seed,
-        max_seconds=limit,
-        **settings,
-    )
-    times = {"first": r.time_to_first}
-    if r.success:
-        times["optimal"] = r.time_to_stop
+def run_native(h, g, s, e, bound, limit, name) -> dict:
+    algo, step = name.removesuffix("-m"), BEST_ETA if name.endswith("-m") else 0.0
+    r = h.solve(algo, s, e, bound, limit, step)
     clipped = len(r.path) > 0 and not path_free(g, r.path)
-    return {"times": {k: v for k, v in times.items() if not math.isnan(v)}, "clipped": clipped}
+    return {"first": r.first, "stop": r.stop, "setup": r.setup, "clipped": clipped}
 
 
-def run_ompl(g, start, goal, bound, limit, name, matched) -> dict:
-    """OMPL planner ``name`` on RealVectorStateSpace(2) with a Python point validity checker
-    (motions checked every 0.5 px); a termination callback records the first-solution and
-    1%-of-optimum times."""
-    from ompl import base as ob
-    from ompl import geometric as og
-
-    h, w = g.shape
-    space = ob.RealVectorStateSpace(2)
-    box = ob.RealVectorBounds(2)
-    box.setLow(0, 0.0), box.setHigh(0, float(w)), box.setLow(1, 0.0), box.setHigh(1, float(h))
-    space.setBounds(box)
-    si = ob.SpaceInformation(space)
-    grid = g.tolist()
-    si.setStateValidityChecker(lambda s: not grid[int(s[1])][int(s[0])])
-    si.setStateValidityCheckingResolution(0.5 / si.getMaximumExtent())
-    si.setup()
-    s, e = space.allocState(), space.allocState()
-    s[0], s[1], e[0], e[1] = *start, *goal
-    pdef = ob.ProblemDefinition(si)
-    pdef.setStartAndGoalStates(s, e, 1e-6)
-    objective = ob.PathLengthOptimizationObjective(si)
-    objective.setCostThreshold(ob.Cost(bound))
-    pdef.setOptimizationObjective(objective)
-    planner = getattr(og, name)(si)
-    if matched and hasattr(planner, "setRange"):
-        planner.setRange(ETA)
-    planner.setProblemDefinition(pdef)
-    planner.setup()
-    times, t0 = {}, time.perf_counter()
-
-    def stop() -> bool:
-        now, c = time.perf_counter() - t0, planner.bestCost().value()
-        if c < math.inf and "first" not in times:
-            times["first"] = now
-        if c <= bound and "optimal" not in times:
-            times["optimal"] = now
-        return now >= limit or "optimal" in times
-
-    planner.solve(ob.PlannerTerminationCondition(stop))
-    stop()  # OMPL returns as soon as its cost threshold is met, before asking stop() again
-    ok = pdef.hasExactSolution()
-    path = np.array([[st[0], st[1]] for st in pdef.getSolutionPath().getStates()]) if ok else None
-    return {"times": times, "clipped": path is not None and not path_free(g, path)}
+def run_python(g, s, e, bound, limit, name) -> dict:
+    algo, step = name.removesuffix("-m"), BEST_ETA if name.endswith("-m") else 0.0
+    r = ompl_python.solve(g, s, e, bound, limit, algo, step)
+    clipped = r["path"] is not None and not path_free(g, r["path"])
+    return {"first": r["first"], "stop": r["stop"], "clipped": clipped}
 
 
-# --- the report ----------------------------------------------------------------------------------
+def floor_seconds(g, s, e, repeats: int = 5) -> float:
+    """Median seconds of the exact solve (the visibility-graph A*, a whole call)."""
+    times = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        any_angle_path(g, s, e)
+        times.append(time.perf_counter() - t0)
+    return float(np.median(times))
+
+
+def bench_map(native, g, s, e, trials, limit, seed, python) -> dict:
+    """Every planner's runs on one instance, alternating per trial."""
+    exact = any_angle_path(g, s, e)[1]
+    bound = 1.01 * exact
+    native.set_map(g)
+    runs: dict[str, list[dict]] = {}
+    for k in range(trials):
+        for label, config in OURS.items():
+            config = config.replace(max_seconds=limit)  # validated here, not in the timed call
+            runs.setdefault(label, []).append(run_ours(g, s, e, exact, (*seed, k), config))
+        for name in NATIVE:
+            runs.setdefault(f"n-{name}", []).append(run_native(native, g, s, e, bound, limit, name))
+        for name in PYTHON if python else ():
+            runs.setdefault(f"p-{name}", []).append(run_python(g, s, e, bound, limit, name))
+    return {"exact": exact, "floor": floor_seconds(g, s, e), "runs": runs}
 
 
 def median_time(runs: list[dict], key: str, limit: float) -> tuple[float, bool]:
-    """Median seconds to ``key`` over trials (a miss counts as ``limit``), and whether it
-    is a lower bound (half or more missed)."""
-    vals = np.array([r["times"].get(key, math.inf) for r in runs])
-    return float(np.median(np.minimum(vals, limit))), 2 * np.isinf(vals).sum() >= len(vals)
+    """Median seconds to ``key`` over trials (a miss counts as ``limit``), and whether it is
+    a lower bound (half or more missed)."""
+    vals = np.array([r[key] for r in runs])
+    missed = np.isnan(vals)
+    return float(np.median(np.where(missed, limit, vals))), 2 * missed.sum() >= len(vals)
 
 
-def report(per_map: dict, names: list[str], limit: float) -> None:
-    omplers = [n for n in names if n.startswith("ompl")]
-    for key, label in (("first", "first solution"), ("optimal", "<= 1.01 x exact optimum")):
-        print(f"\nmedian ms to the {label}, per map (ratio = best OMPL / ours-best)")
-        wide = max(map(len, names)) + 2
-        print(f"{'map':<16}" + "".join(f"{n:>{wide}}" for n in names) + f"{'ratio':>9}")
-        ratios = []
-        for name, runs in per_map.items():
-            meds = {n: median_time(runs[n], key, limit) for n in names}
-            cells = "".join(
-                f"{('>=' if c else '') + f'{1e3 * m:.3g}':>{wide}}" for m, c in meds.values()
-            )
-            best = min(meds[n][0] for n in omplers)
-            ratio = best / max(meds["ours-best"][0], 1e-9)
-            ratios.append(ratio)
-            print(f"{name:<16}{cells}{ratio:>9.1f}")
-        overall = {
-            n: np.median([median_time(per_map[m][n], key, limit)[0] for m in per_map])
-            for n in names
-        }
-        print(f"{'median of maps':<16}" + "".join(f"{1e3 * overall[n]:>{wide}.3g}" for n in names))
-        best = min(overall[n] for n in omplers) / overall["ours-best"]
-        print(
-            f"ours-best vs the best OMPL planner: median over maps {best:.1f}x; per map: "
-            f"median ratio {np.median(ratios):.1f}x, worst {min(ratios):.2f}x"
-        )
-    for n in names:
-        runs = [r for per in per_map.values() for r in per[n]]
-        print(
-            f"{n}: final paths clipping an obstacle (exact test): "
-            f"{sum(r['clipped'] for r in runs)}/{len(runs)}"
-        )
+def _cell(value: float, lower: bool, wide: int) -> str:
+    return f"{('>=' if lower else '') + f'{1e3 * value:.3g}':>{wide}}"
 
 
-def main(argv: list[str] | None = None) -> None:
+def medians(per_map: dict, names: list[str], key: str, limit: float) -> dict:
+    """``{map: {planner: (median s, lower bound)}}``; ``ours-call`` is ours-best's call."""
+
+    def one(runs: dict, n: str) -> tuple[float, bool]:
+        if n == "ours-call":
+            return median_time(runs["ours-best"], "call", limit)
+        return median_time(runs[n], key, limit)
+
+    return {m: {n: one(v["runs"], n) for n in names} for m, v in per_map.items()}
+
+
+def summary(meds: dict, ours: str, group: list[str], short: dict) -> str:
+    """``ours`` against the best of ``group``: the ratio of the medians over maps (the best
+    planner of the group by its median over maps), the per-map ratio's median and worst."""
+    overall = {n: float(np.median([med[n][0] for med in meds.values()])) for n in [ours, *group]}
+    best = min(group, key=overall.get)
+    ratios = sorted((min(med[n][0] for n in group) / max(med[ours][0], 1e-9), m)
+                    for m, med in meds.items())  # fmt: skip
+    vals = [r for r, _ in ratios]
+    return (f"{ours} vs the best of {short[group[0]][:2]}*: median over maps "
+            f"{overall[best] / overall[ours]:.1f}x ({short[best]} {1e3 * overall[best]:.3g} ms "
+            f"vs {1e3 * overall[ours]:.3g} ms); per map: median {np.median(vals):.1f}x, worst "
+            f"{ratios[0][0]:.2f}x ({ratios[0][1]}), slower on {sum(v < 1 for v in vals)} of "
+            f"{len(vals)} maps")  # fmt: skip
+
+
+def table(per_map: dict, key: str, limit: float) -> None:
+    """Per-map medians (ms) of every planner to ``key``, the best native planner and the
+    ratio to ours; the median over maps and the summary lines."""
+    names = [n for n in next(iter(per_map.values()))["runs"] if n != "ours-best"]
+    names = ["ours-best", *(["ours-call"] if key == "stop" else []), *names]
+    natives = [n for n in names if n.startswith("n-")]
+    pythons = [n for n in names if n.startswith("p-")]
+    short = {n: n.replace("Informed", "I").replace("star", "*") for n in names}
+    wide = max(9, *(len(v) + 1 for v in short.values()))
+    meds = medians(per_map, names, key, limit)
+    print(f"{'map':<15}" + "".join(f"{short[n]:>{wide}}" for n in names)
+          + f"{'best native':>13}{'ratio':>8}")  # fmt: skip
+    for name, med in meds.items():
+        best = min(natives, key=lambda n: med[n][0])
+        ratio = (
+            ">=" if med[best][1] else ""
+        ) + f"{med[best][0] / max(med['ours-best'][0], 1e-9):.1f}"
+        cells = "".join(_cell(*med[n], wide) for n in names)
+        print(f"{name:<15}{cells}{short[best]:>13}{ratio:>8}")
+    overall = {n: np.median([med[n][0] for med in meds.values()]) for n in names}
+    print(f"{'median of maps':<15}" + "".join(f"{1e3 * overall[n]:>{wide}.3g}" for n in names))
+    print(summary(meds, "ours-best", natives, short))
+    if key == "stop":
+        print(summary(meds, "ours-call", natives, short))
+    if pythons:
+        print(summary(meds, "ours-best", pythons, short))
+
+
+def report(title: str, per_map: dict, limit: float) -> bool:
+    """Print a set's tables, floor and path checks; False when one of our paths failed."""
+    print(f"\n===== {title}: {len(per_map)} maps =====")
+    for key, label in (("first", "first solution"), ("stop", "<= 1.01 x exact optimum")):
+        print(f"\nmedian ms to the {label}, per map (ratio = best native OMPL / ours-best)")
+        table(per_map, key, limit)
+    print("\nthe floor: the exact solve (visibility-graph A*) against ours-best to 1%")
+    rows = []
+    for name, m in per_map.items():
+        ours = median_time(m["runs"]["ours-best"], "call", limit)[0]
+        rows.append(ours / m["floor"])
+        print(f"{name:<15}exact {1e3 * m['floor']:8.3f} ms  ours-best call {1e3 * ours:8.3g} ms"
+              f"  ours / exact {rows[-1]:7.2f}")  # fmt: skip
+    print(
+        f"ours-best call / exact solve: median over maps {np.median(rows):.2f}, "
+        f"best {min(rows):.2f}, worst {max(rows):.2f}"
+    )
+    good = True
+    for n in next(iter(per_map.values()))["runs"]:
+        runs = [r for m in per_map.values() for r in m["runs"][n]]
+        bad = sum(r["clipped"] for r in runs)
+        good &= bad == 0 or not n.startswith("ours")
+        what = "paths failing the exact test or the stop rule" if n.startswith("ours") else (
+            "final paths clipping an obstacle (exact test)")  # fmt: skip
+        print(f"{n}: {what}: {bad}/{len(runs)}")
+    return good
+
+
+def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--random", type=int, default=12, help="random test maps (beside 10 fixed)")
-    ap.add_argument("--trials", type=int, default=3, help="runs per map and planner")
+    ap.add_argument("--trials", type=int, default=5, help="runs per map and planner")
     ap.add_argument("--time-limit", type=float, default=2.0, help="seconds per run")
+    ap.add_argument("--sets", default="dev,held_out", help="dev, held_out or both")
+    ap.add_argument("--maps", help="only these maps (comma-separated names)")
+    ap.add_argument("--no-python", action="store_true", help="skip OMPL's Python bindings")
     ap.add_argument("--seed", type=int, default=0)
     args = ap.parse_args(argv)
-    from ompl import util as ou
-
-    ou.setLogLevel(ou.LogLevel.LOG_WARN)
-    ou.RNG.setSeed(args.seed + 1)
+    binary = ompl_native.build_or_explain()
+    if binary is None:
+        return 2
+    if not args.no_python:
+        ompl_python.quiet(args.seed + 1)
     warmup()  # JIT compilation (or cache load) outside every timing
-    names = [
-        *OURS,
-        *(f"ompl-{n}" for n in OMPL),
-        "ompl-RRTstar-matched",
-        "ompl-InformedRRTstar-matched",
-    ]
-    per_map = {}
-    for m, (name, g, s, e) in enumerate(make_instances(args.random, args.seed)):
-        bound = 1.01 * any_angle_path(g, s, e)[1]
-        runs = {n: [] for n in names}
-        for k in range(args.trials):
-            seed = (args.seed, m, k)
-            for label, settings in OURS.items():
-                runs[label].append(run_ours(g, s, e, bound, seed, args.time_limit, settings))
-            for n in names[len(OURS) :]:
-                algo = n.removeprefix("ompl-").removesuffix("-matched")
-                runs[n].append(
-                    run_ompl(g, s, e, bound, args.time_limit, algo, n.endswith("matched"))
-                )
-        per_map[name] = runs
-        print(f"{name}: exact optimum {bound / 1.01:.1f} px", flush=True)
-    report(per_map, names, args.time_limit)
+    sets = {"dev": dev_instances, "held_out": held_out_instances}
+    good = True
+    with ompl_native.Harness(binary, args.seed + 1) as native:
+        for set_name in args.sets.split(","):
+            per_map = {}
+            for m, (name, g, s, e) in enumerate(sets[set_name](seed=args.seed)):
+                m += 1000 * list(sets).index(set_name)
+                if args.maps and name not in args.maps.split(","):
+                    continue
+                per_map[name] = bench_map(native, g, s, e, args.trials, args.time_limit,
+                                          (args.seed, m), not args.no_python)  # fmt: skip
+                print(f"{set_name} {name}: exact optimum {per_map[name]['exact']:.1f} px",
+                      flush=True)  # fmt: skip
+            good &= report(set_name, per_map, args.time_limit)
+    return 0 if good else 1
 
 
 if __name__ == "__main__":
-    main()
+    code = main()
     sys.stdout.flush()
     sys.stderr.flush()
-    os._exit(0)  # skip interpreter teardown: OMPL's nanobind bindings print leak warnings
+    os._exit(code)  # skip interpreter teardown: OMPL's nanobind bindings print leak warnings

@@ -9,9 +9,12 @@ import pytest
 from vnrrt.grid import GridError
 from vnrrt.planners import (
     PLANNERS,
+    Planner,
+    PlannerConfig,
     PlannerConfigError,
     any_angle_length,
     astar_length,
+    make_sampler,
     plan,
     segment_free,
 )
@@ -60,10 +63,10 @@ def heat(grid):
     return heatmap_for(grid, START, GOAL)
 
 
-def kwargs_for(planner, heat):
-    if planner == "rrt_star":
-        return {}
-    return {"heatmap": heat, "tau": 0.5 if planner == "m_vnrrt_star" else None}
+def kwargs_for(planner, heat, **settings):
+    """The heatmap and config arguments of ``planner`` (M-VNRRT* masks below tau 0.5)."""
+    config = PlannerConfig(tau=0.5, **settings)
+    return {"config": config} if planner == "rrt_star" else {"heatmap": heat, "config": config}
 
 
 def check_path(grid, r, start, goal):
@@ -99,7 +102,8 @@ def test_any_angle_reference_and_milestones(grid):
     tight = any_angle_length(grid, START, GOAL)
     loose = astar_length(grid, START, GOAL)
     assert math.dist(START, GOAL) < tight < loose
-    r = plan(grid, START, GOAL, stop="optimal", reference="any_angle", milestones=(1.01 * loose,))
+    r = plan(grid, START, GOAL, stop="optimal", config=PlannerConfig(reference="any_angle"),
+             milestones=(1.01 * loose,))  # fmt: skip
     check_path(grid, r, START, GOAL)
     assert r.cost <= 1.01 * tight
     (m,) = r.milestones
@@ -134,10 +138,11 @@ def test_tree_edges_are_free(grid):
 
 
 def test_budgets_are_failures_not_exceptions(grid):
-    r = plan(grid, START, GOAL, stop="initial", max_iterations=30)
+    r = plan(grid, START, GOAL, stop="initial", config=PlannerConfig(max_iterations=30))
     assert not r.success and r.stop_reason == "max_iterations" and r.iterations == 30
     assert r.path.shape == (0, 2) and math.isinf(r.cost) and math.isnan(r.time_to_first)
-    r = plan(grid, START, GOAL, stop="optimal", reference_length=1.0, max_seconds=0.05)
+    r = plan(grid, START, GOAL, stop="optimal", reference_length=1.0,
+             config=PlannerConfig(max_seconds=0.05))  # fmt: skip
     assert not r.success and r.stop_reason == "max_seconds" and r.path.shape[1] == 2
 
 
@@ -147,7 +152,8 @@ def test_budgets_are_failures_not_exceptions(grid):
      {"gamma": 50.0}, {"mix": 1.0}],
 )  # fmt: skip
 def test_config_variants_still_valid(grid, heat, settings):
-    r = plan(grid, START, GOAL, "nrrt_star", heatmap=heat, stop="optimal", seed=5, **settings)
+    r = plan(grid, START, GOAL, "nrrt_star", heatmap=heat, stop="optimal", seed=5,
+             config=PlannerConfig(**settings))  # fmt: skip
     check_path(grid, r, START, GOAL)
     assert r.cost <= 1.01 * astar_length(grid, START, GOAL)
 
@@ -159,7 +165,8 @@ def test_direct_line_of_sight_is_immediate(grid):
 
 
 def test_masked_fallback_is_recorded(grid, heat):
-    r = plan(grid, START, GOAL, "m_vnrrt_star", heatmap=heat, tau=5.0, seed=1)
+    r = plan(grid, START, GOAL, "m_vnrrt_star", heatmap=heat, config=PlannerConfig(tau=5.0),
+             seed=1)  # fmt: skip
     assert r.success and r.fallback_uniform
 
 
@@ -176,8 +183,18 @@ def test_masked_fallback_is_recorded(grid, heat):
         ((START, GOAL, "rrt_star"), {"heatmap": np.ones((200, 200))}, ValueError, "no heatmap"),
         ((START, GOAL, "astar_star"), {}, ValueError, "unknown planner"),
         ((START, GOAL), {"stop": "best"}, ValueError, "stop rule"),
-        ((START, GOAL), {"eta": -1.0}, PlannerConfigError, "eta"),
-        ((START, GOAL), {"etta": 1.0}, PlannerConfigError, "unknown"),
+        ((START, GOAL), {"config": PlannerConfig(eta=-1.0)}, PlannerConfigError, "eta"),
+        ((START, GOAL), {"config": {"eta": 1.0}}, TypeError, "PlannerConfig"),
+        ((START, GOAL), {"eta": 1.0}, TypeError, "eta"),
+        ((START, GOAL), {"tau": 0.5}, TypeError, "tau"),
+        ((START, GOAL), {"seed": -1}, ValueError, "seed"),
+        ((START, GOAL), {"seed": (1, 2.5)}, ValueError, "seed"),
+        (
+            (START, GOAL),
+            {"reference_length": math.nan, "stop": "optimal"},
+            ValueError,
+            "reference_length",
+        ),
     ],
 )
 def test_bad_input_gives_clear_error(grid, args, kwargs, error, match):
@@ -190,15 +207,15 @@ def test_disconnected_optimal_needs_a_path():
     g[95:105, 98:102] = 1
     with pytest.raises(NoPathError):
         plan(g, START, GOAL, stop="optimal")
-    r = plan(g, START, GOAL, stop="initial", max_iterations=2000)
+    r = plan(g, START, GOAL, stop="initial", config=PlannerConfig(max_iterations=2000))
     assert not r.success
 
 
 @pytest.mark.parametrize("planner", PLANNERS)
 @pytest.mark.parametrize("seed", range(5))
 def test_optimal_any_angle_many_seeds(grid, heat, planner, seed):
-    kw = kwargs_for(planner, heat)
-    r = plan(grid, START, GOAL, planner, stop="optimal", reference="any_angle", seed=seed, **kw)
+    kw = kwargs_for(planner, heat, reference="any_angle")
+    r = plan(grid, START, GOAL, planner, stop="optimal", seed=seed, **kw)
     check_path(grid, r, START, GOAL)
     assert r.cost <= 1.01 * any_angle_length(grid, START, GOAL)
 
@@ -226,10 +243,10 @@ def test_random_maps_all_planners(planner, seed):
         tight = any_angle_length(g, s, e)
     except NoPathError:
         pytest.skip("corners not connected on this map")
-    kw = kwargs_for(planner, heatmap_for(g, s, e))
+    kw = kwargs_for(planner, heatmap_for(g, s, e), reference="any_angle")
     first = plan(g, s, e, planner, seed=seed, **kw)
     check_path(g, first, s, e)
-    best = plan(g, s, e, planner, stop="optimal", reference="any_angle", seed=seed, **kw)
+    best = plan(g, s, e, planner, stop="optimal", seed=seed, **kw)
     check_path(g, best, s, e)
     assert best.cost <= 1.01 * tight <= 1.01 * astar_length(g, s, e)
 
@@ -244,9 +261,9 @@ def test_min_spacing_stops_nodes_piling_up_under_a_concentrated_heatmap(grid, sp
     hx, hy = 20, 20
     hot[hy, hx] = 1.0
     # reference 1 px: never reached, so the run takes all 4,000 iterations
-    r = plan(grid, (5.5, 5.5), (54.5, 54.5), "m_vnrrt_star", heatmap=hot, tau=0.5,
-             stop="optimal", reference_length=1.0, seed=3, keep_tree=True,
-             min_spacing=spacing, max_iterations=4000)  # fmt: skip
+    cfg = PlannerConfig(tau=0.5, min_spacing=spacing, max_iterations=4000)
+    r = plan(grid, (5.5, 5.5), (54.5, 54.5), "m_vnrrt_star", heatmap=hot, config=cfg,
+             stop="optimal", reference_length=1.0, seed=3, keep_tree=True)  # fmt: skip
     pts = r.tree_points
     inside = (np.floor(pts[:, 0]) == hx) & (np.floor(pts[:, 1]) == hy)
     if spacing > 0:
@@ -260,4 +277,37 @@ def test_min_spacing_stops_nodes_piling_up_under_a_concentrated_heatmap(grid, sp
 
 def test_min_spacing_must_be_below_the_steer_step(grid):
     with pytest.raises(PlannerConfigError, match="min_spacing"):
-        plan(grid, (5.5, 5.5), (54.5, 54.5), min_spacing=20.0)
+        plan(grid, (5.5, 5.5), (54.5, 54.5), config=PlannerConfig(min_spacing=20.0))
+
+
+@pytest.mark.parametrize("planner", PLANNERS)
+def test_a_planner_set_up_once_answers_as_plan_does(grid, heat, planner):
+    """One Planner (grid, sampler and settings checked once) solving several queries gives,
+    per seed, exactly what a plan() call gives."""
+    kw = kwargs_for(planner, heat, straight_first=True, informed=True)
+    once = Planner(grid, planner, **kw)
+    for seed, (s, e) in enumerate([(START, GOAL), (GOAL, START), ((10.5, 10.5), (15.5, 12.5))]):
+        a = once.solve(s, e, stop="optimal", seed=seed)
+        b = plan(grid, s, e, planner, stop="optimal", seed=seed, **kw)
+        assert (a.cost, a.iterations, a.tree_size, a.collision_checks) == (
+            b.cost, b.iterations, b.tree_size, b.collision_checks)  # fmt: skip
+        np.testing.assert_array_equal(a.path, b.path)
+
+
+@pytest.mark.parametrize(
+    ("built", "config", "kwargs", "match"),
+    [
+        ({"tau": 0.5}, {"tau": 0.9}, {}, "built with tau=0.5"),
+        ({"mix": 0.5}, {"mix": 0.8}, {}, "built with mix=0.5"),
+        ({}, {}, {"heatmap": np.ones((200, 200))}, "not both"),
+        ({}, {}, {"planner": "vnrrt_star"}, "heatmap sampler, got a masked"),
+    ],
+)
+def test_a_prebuilt_sampler_is_checked_against_the_config(grid, heat, built, config, kwargs, match):
+    sampler = make_sampler("m_vnrrt_star", grid.shape, heat, PlannerConfig(**built))
+    args = {"planner": "m_vnrrt_star", "config": PlannerConfig(**config), **kwargs}
+    with pytest.raises(ValueError, match=match):
+        plan(grid, START, GOAL, sampler=sampler, **args)
+    small = make_sampler("rrt_star", (100, 200))
+    with pytest.raises(GridError, match="shape"):
+        plan(grid, START, GOAL, sampler=small)

@@ -15,6 +15,7 @@ from scipy import stats
 
 from vnrrt.maps.named import named_map
 from vnrrt.planners import (
+    PlannerConfig,
     any_angle_path,
     core,
     draw,
@@ -23,7 +24,9 @@ from vnrrt.planners import (
     plan,
     uniform_sampler,
 )
-from vnrrt.planners.api import FIRST_CAPACITY, warmup
+from vnrrt.planners import tree as nodes
+from vnrrt.planners.api import warmup
+from vnrrt.planners.run import FIRST_CAPACITY
 from vnrrt.planners.samplers import HEATMAP_TRIES, rng_state
 
 
@@ -140,10 +143,10 @@ def test_nodes_added_after_a_solution_can_improve_it_and_the_best_path_is_kept(p
     fm = named_map("u_trap", 200)
     s, g = fm.starts[0] + 0.5, fm.goals[0] + 0.5
     heat = None if planner == "rrt_star" else np.random.default_rng(1).random((200, 200))
-    kw = dict(planner=planner, heatmap=heat, informed=True, keep_tree=True, seed=2)
-    first = plan(fm.grid, s, g, stop="initial", **kw)
+    kw = dict(planner=planner, heatmap=heat, keep_tree=True, seed=2)
+    first = plan(fm.grid, s, g, stop="initial", config=PlannerConfig(informed=True), **kw)
     r = plan(fm.grid, s, g, stop="optimal", reference_length=any_angle_path(fm.grid, s, g)[1],
-             max_seconds=20, **kw)  # fmt: skip
+             config=PlannerConfig(informed=True, max_seconds=20), **kw)  # fmt: skip
     n = first.tree_size
     np.testing.assert_array_equal(r.tree_points[:n], first.tree_points)
     assert np.array_equal(first.tree_points[-1], g)  # the goal joined last: n - 1
@@ -164,7 +167,7 @@ def test_uninformed_runs_add_nodes_that_cannot_improve_the_first_solution():
     s, g = fm.starts[0] + 0.5, fm.goals[0] + 0.5
     first = plan(fm.grid, s, g, stop="initial", keep_tree=True, seed=2)
     r = plan(fm.grid, s, g, stop="optimal", reference_length=1.0, keep_tree=True, seed=2,
-             max_iterations=4000)  # fmt: skip
+             config=PlannerConfig(max_iterations=4000))  # fmt: skip
     np.testing.assert_array_equal(r.tree_points[: first.tree_size], first.tree_points)
     later = r.tree_points[first.tree_size :]
     f_hat = costs_to_come(r.tree_points, r.tree_parents)[first.tree_size :]
@@ -184,29 +187,30 @@ def test_informed_planners_reach_the_exact_optimum_on_trap_maps(name, planner):
         heat = 0.01 + np.sum(blobs, axis=0)
     for seed in range(3):
         r = plan(fm.grid, s, g, planner, heatmap=heat, stop="optimal", reference_length=exact,
-                 informed=True, seed=seed, max_seconds=20)  # fmt: skip
+                 config=PlannerConfig(informed=True, max_seconds=20), seed=seed)  # fmt: skip
         assert r.success and r.cost <= 1.01 * exact + 1e-9 and path_free(fm.grid, r.path)
 
 
 def test_the_straight_segment_first_is_the_optimum_at_once():
     grid = np.zeros((100, 100), np.uint8)
     s, g = (3.5, 4.5), (96.5, 91.5)
-    r = plan(grid, s, g, stop="optimal", straight_first=True, reference_length=math.dist(s, g))
+    first = PlannerConfig(straight_first=True)
+    r = plan(grid, s, g, stop="optimal", config=first, reference_length=math.dist(s, g))
     assert r.success and r.iterations == 0 and r.cost == pytest.approx(math.dist(s, g))
     assert r.time_to_first == r.time_to_stop and r.tree_size == 2
     np.testing.assert_allclose(r.path, [s, g])
-    tree = plan(grid, s, g, straight_first=True, keep_tree=True)
+    tree = plan(grid, s, g, config=first, keep_tree=True)
     np.testing.assert_allclose(tree.tree_points, [s, g])
     assert list(tree.tree_parents) == [-1, 0]
     # a stop bound below the straight segment cannot be met: the search runs to its budget
-    short = plan(grid, s, g, stop="optimal", straight_first=True, reference_length=10.0,
-                 max_iterations=300, seed=0)  # fmt: skip
+    short = plan(grid, s, g, stop="optimal", reference_length=10.0, seed=0,
+                 config=first.replace(max_iterations=300))  # fmt: skip
     assert not short.success and short.stop_reason == "max_iterations"
     assert short.time_to_first < short.time_to_stop
     assert short.cost == pytest.approx(math.dist(s, g))
     blocked = grid.copy()
     blocked[40:60, 40:60] = 1
-    r2 = plan(blocked, s, g, stop="initial", straight_first=True, seed=0)
+    r2 = plan(blocked, s, g, stop="initial", config=first, seed=0)
     assert r2.iterations > 0  # no straight segment: the search runs as usual
 
 
@@ -216,9 +220,9 @@ def test_an_unreachable_bound_runs_exactly_the_iteration_budget(budget, straight
     """With the goal joined at once (straight segment, any-distance goal radius) and nearly
     every iteration adding a node (an empty map), the tree has room for the whole budget."""
     grid = np.zeros((100, 100), np.uint8)
-    r = plan(grid, (3.5, 4.5), (96.5, 91.5), stop="optimal", reference_length=1.0,
-             goal_radius=math.inf, straight_first=straight_first,
-             max_iterations=budget)  # fmt: skip
+    cfg = PlannerConfig(goal_radius=math.inf, straight_first=straight_first,
+                        max_iterations=budget)  # fmt: skip
+    r = plan(grid, (3.5, 4.5), (96.5, 91.5), stop="optimal", reference_length=1.0, config=cfg)
     assert r.stop_reason == "max_iterations" and r.iterations == budget
 
 
@@ -228,15 +232,16 @@ def test_tree_memory_follows_the_work_done_not_the_budget(monkeypatch):
     up to the budget (+ root and goal)."""
     warmup()  # its own small runs first
     sizes = []
-    new_tree, enlarge = core.new_tree, core.enlarge
-    monkeypatch.setattr(core, "new_tree", lambda c, *a: sizes.append(c) or new_tree(c, *a))
-    monkeypatch.setattr(core, "enlarge", lambda t, c: sizes.append(c) or enlarge(t, c))
+    new_tree, enlarge = nodes.new_tree, nodes.enlarge
+    monkeypatch.setattr(nodes, "new_tree", lambda c, *a: sizes.append(c) or new_tree(c, *a))
+    monkeypatch.setattr(nodes, "enlarge", lambda t, c: sizes.append(c) or enlarge(t, c))
     fm = named_map("cluttered", 200)
     s, g = fm.starts[0] + 0.5, fm.goals[0] + 0.5
-    r = plan(fm.grid, s, g, max_iterations=10**9, seed=0)
+    r = plan(fm.grid, s, g, config=PlannerConfig(max_iterations=10**9), seed=0)
     assert r.success and sizes == [FIRST_CAPACITY] and r.tree_size < FIRST_CAPACITY
     sizes.clear()
-    r = plan(fm.grid, s, g, stop="optimal", reference_length=1.0, max_iterations=10_000)
+    r = plan(fm.grid, s, g, stop="optimal", reference_length=1.0,
+             config=PlannerConfig(max_iterations=10_000))  # fmt: skip
     assert r.stop_reason == "max_iterations" and r.iterations == 10_000
     assert sizes[0] == FIRST_CAPACITY and len(sizes) > 1
     assert all(b == min(2 * a, 10_002) for a, b in itertools.pairwise(sizes))
@@ -250,7 +255,8 @@ def test_a_node_that_sees_the_goal_connects_at_any_distance():
     s, g = fm.starts[0] + 0.5, fm.goals[0] + 0.5
     last = []
     for radius in (math.inf, None):
-        edges = [np.linalg.norm(np.diff(plan(fm.grid, s, g, goal_radius=radius, seed=k).path[-2:],
+        cfg = PlannerConfig(goal_radius=radius)
+        edges = [np.linalg.norm(np.diff(plan(fm.grid, s, g, config=cfg, seed=k).path[-2:],
                                         axis=0)) for k in range(5)]  # fmt: skip
         last.append(max(edges))
     assert last[0] > 2 * 10.0 and last[1] <= 10.0 + 1e-9
@@ -261,9 +267,9 @@ def test_same_seed_same_result_for_every_informed_planner(planner):
     fm = named_map("cluttered", 200)
     s, g = fm.starts[0] + 0.5, fm.goals[0] + 0.5
     heat = None if planner == "rrt_star" else np.random.default_rng(3).random((200, 200))
-    tau = 0.5 if planner == "m_vnrrt_star" else None
-    kw = dict(planner=planner, heatmap=heat, tau=tau, stop="optimal", informed=True,
-              goal_radius=math.inf, straight_first=True, max_iterations=3000)  # fmt: skip
+    cfg = PlannerConfig(tau=0.5, informed=True, goal_radius=math.inf, straight_first=True,
+                        max_iterations=3000)  # fmt: skip
+    kw = dict(planner=planner, heatmap=heat, stop="optimal", config=cfg)
     a, b, c = (plan(fm.grid, s, g, seed=k, **kw) for k in (5, 5, 6))
     assert a.cost == b.cost and a.iterations == b.iterations
     np.testing.assert_array_equal(a.path, b.path)

@@ -5,7 +5,8 @@ import pytest
 from scipy import stats
 
 from vnrrt.grid import GridError
-from vnrrt.planners import draw, heatmap_sampler, make_sampler, uniform_sampler
+from vnrrt.planners import PlannerConfig, draw, heatmap_sampler, make_sampler, uniform_sampler
+from vnrrt.planners.seeding import rng_state
 
 N = 200_000
 
@@ -67,8 +68,8 @@ def test_masked_never_below_tau(heat, tau):
 
 
 def test_masked_falls_back_to_uniform_when_empty(heat):
-    s = make_sampler("m_vnrrt_star", heat.shape, heat, tau=2.0)
-    assert s.fallback_uniform and s.mix == 0.0
+    s = make_sampler("m_vnrrt_star", heat.shape, heat, PlannerConfig(tau=2.0))
+    assert s.fallback_uniform and s.draw_mix == 0.0 and s.mix == 0.5 and s.tau == 2.0
     assert not make_sampler("vnrrt_star", heat.shape, heat).fallback_uniform
 
 
@@ -85,3 +86,62 @@ def test_same_seed_same_draws(heat):
 def test_bad_heatmaps_are_refused(bad):
     with pytest.raises(GridError):
         heatmap_sampler(bad, (9, 11))
+
+
+@pytest.mark.parametrize(
+    ("weights", "why"),
+    [
+        ([1e308, 0.5e308, 1e308], "the raw total overflows: every draw landed in the last pixel"),
+        ([0.6e308] * 5 + [0.0], "the raw total overflows midway"),
+        ([5e-324, 5e-324, 5e-324], "subnormal weights: the draw rounded to a multiple of one"),
+    ],
+)
+def test_numerically_hostile_weights_are_drawn_in_proportion(weights, why):
+    """Finite weights whose total overflows (or is subnormal) are scaled by a power of two
+    before they are summed: the pixel frequencies follow the weights' proportions."""
+    hm = np.array([weights], dtype=np.float64)
+    s = heatmap_sampler(hm, hm.shape, mix=1.0)
+    assert np.isfinite(s.cdf).all() and s.cdf[-1] > 0.5, why
+    counts = pixel_counts(draw(s, 60_000, seed=11), hm.shape)
+    share = hm.ravel() / hm.ravel().max()  # the proportions, computed without overflow
+    pos = share > 0
+    assert counts[~pos].sum() == 0
+    expected = share[pos] / share[pos].sum() * counts.sum()
+    assert stats.chisquare(counts[pos], expected).pvalue > 1e-3, why
+
+
+@pytest.mark.parametrize("tau", [None, 0.5, 0.9])
+def test_probability_maps_keep_their_draws_bit_for_bit(tau):
+    """A probability map (a network's float32 sigmoid output, values in [0, 1]) is summed as
+    it is: the cdf equals the plain cumulative sum of its weights, so the draws of every
+    existing seed are unchanged by the scaling of hostile weights."""
+    rng = np.random.default_rng(4)
+    logits = rng.normal(-3.0, 3.0, (200, 200))
+    hm = (1 / (1 + np.exp(-logits))).astype(np.float32)
+    s = heatmap_sampler(hm, hm.shape, mix=0.5, tau=tau)
+    flat = hm.astype(np.float64).ravel()
+    raw = np.cumsum(flat if tau is None else np.where(flat >= tau, flat, 0.0))
+    assert np.array_equal(s.cdf, raw) and s.cdf[-1] == raw[-1]
+    ones = heatmap_sampler(np.ones((200, 200)), (200, 200))
+    assert np.array_equal(ones.cdf, np.arange(1.0, 40_001.0))  # max 1: not rescaled either
+
+
+def numpy_state(seed) -> np.ndarray:
+    state = np.random.SeedSequence(seed).generate_state(4, dtype=np.uint64)
+    state[0] += not state.any()
+    return state
+
+
+def test_the_compiled_seeding_is_numpys_seed_sequence_bit_for_bit():
+    """rng_state reimplements SeedSequence(seed).generate_state(4, uint64) in a kernel: the
+    same state for ints of any size, tuples and lists (the evaluation's 63-bit trial seeds,
+    the benchmarks' tuples) and the edge cases of numpy's word assembly."""
+    rng = np.random.default_rng(0)
+    seeds = [0, 1, 2**32 - 1, 2**32, 2**63 - 1, 2**64 + 5, 2**130 + 7, (), (0,), [1, 2, 3, 4, 5]]
+    seeds += [int(v) for v in rng.integers(0, 2**63, 500)]
+    seeds += [tuple(int(v) for v in rng.integers(0, 2**40, rng.integers(1, 7))) for _ in range(500)]
+    for seed in seeds:
+        np.testing.assert_array_equal(rng_state(seed), numpy_state(seed), err_msg=str(seed))
+    assert rng_state(np.int64(7)).dtype == np.uint64
+    with pytest.raises(TypeError):
+        rng_state(1.5)

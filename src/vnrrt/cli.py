@@ -168,9 +168,10 @@ def run_plan(args: argparse.Namespace) -> int:
                          "or --checkpoint CKPT (e.g. models/quick/vertexnet.ckpt)")  # fmt: skip
     if args.out is not None and args.out.is_dir():
         raise UsageError(f"--out {args.out} is a directory; give a .png file name")
-    result = plan(inst["grid"], start, goal, args.planner, heatmap=heatmap, tau=args.tau,
+    result = plan(inst["grid"], start, goal, args.planner, heatmap=heatmap,
                   stop=args.stop, reference_length=_reference(inst, start, goal, cfg),
-                  seed=args.seed, config=cfg, keep_tree=args.out is not None)  # fmt: skip
+                  seed=args.seed, config=cfg if args.tau is None else cfg.replace(tau=args.tau),
+                  keep_tree=args.out is not None)  # fmt: skip
     print(result.summary())
     try:
         a, t = astar_length(inst["grid"], start, goal), any_angle_length(inst["grid"], start, goal)

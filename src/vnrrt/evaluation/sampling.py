@@ -39,17 +39,18 @@ def build_sampler(key: ConfigKey, heatmap: np.ndarray | None, allowed: np.ndarra
         config = config.replace(mix=float(key.mix))
     shape = allowed.shape
     if not free:
-        return make_sampler(key.planner, shape, heatmap, key.tau, config.mix), config
+        return make_sampler(key.planner, shape, heatmap, config), config
     uniform = allowed / allowed.sum()
     if key.planner == "rrt_star":
         s = heatmap_sampler(uniform, shape, 1.0)
         return dataclasses.replace(s, kind="uniform"), config
-    masked = make_sampler(key.planner, shape, heatmap, key.tau, config.mix)
+    masked = make_sampler(key.planner, shape, heatmap, config)
     weights = np.asarray(heatmap, np.float64)
     if key.tau is not None:
         weights = np.where(weights >= key.tau, weights, 0.0)
     total = weights.sum()
     mixture = uniform if total <= 0 else config.mix * weights / total + (1 - config.mix) * uniform
     s = heatmap_sampler(mixture, shape, 1.0)
-    s = dataclasses.replace(s, kind=masked.kind, fallback_uniform=masked.fallback_uniform)
+    s = dataclasses.replace(s, kind=masked.kind, fallback_uniform=masked.fallback_uniform,
+                            tau=masked.tau)  # fmt: skip
     return s, config.replace(mix=1.0)

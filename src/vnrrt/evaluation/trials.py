@@ -94,6 +94,8 @@ def run_job(
     key, stop, config = job.key, job.stop, configs[job.regime]
     if key.informed:
         config = config.replace(informed=True)
+    if key.tau is not None:
+        config = config.replace(tau=key.tau)
     warmup()
     free = free_rule(key, heat.zero_obstacles)
     allowed = sources.allowed_cells(inst.grid, free)

@@ -3,9 +3,9 @@
 Entry point: :func:`plan`. Depends only on :mod:`vnrrt.grid` and :mod:`vnrrt.search`.
 """
 
-from vnrrt.planners.api import make_sampler, plan, warmup
+from vnrrt.planners.api import Planner, make_sampler, plan, warmup
 from vnrrt.planners.collision import path_free, point_free, polyline_length, segment_free
-from vnrrt.planners.config import PLANNERS, PlannerConfig, PlannerConfigError
+from vnrrt.planners.config import FASTEST, PLANNERS, PlannerConfig, PlannerConfigError
 from vnrrt.planners.reference import (
     any_angle_length,
     any_angle_path,
@@ -18,9 +18,11 @@ from vnrrt.planners.result import Milestone, PlanResult
 from vnrrt.planners.samplers import Sampler, draw, heatmap_sampler, uniform_sampler
 
 __all__ = [
+    "FASTEST",
     "PLANNERS",
     "Milestone",
     "PlanResult",
+    "Planner",
     "PlannerConfig",
     "PlannerConfigError",
     "Sampler",

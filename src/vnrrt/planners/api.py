@@ -1,61 +1,39 @@
-"""Public entry point :func:`plan`: validate inputs, build the sampler, run the core, time it.
+"""Public entry points: :class:`Planner` (set up once per map, solved many times) and
+:func:`plan` (one call).
 
 Coordinates follow :mod:`vnrrt.grid`: ``grid`` is ``(H, W)`` indexed ``grid[y, x]``
 (nonzero = obstacle), start and goal are continuous ``(x, y)`` pixel points (cell
-centres ``(x + 0.5, y + 0.5)`` for dataset instances). Timings cover the tree
+centres ``(x + 0.5, y + 0.5)`` for dataset instances). Every setting comes from one
+:class:`PlannerConfig` (the M-VNRRT* threshold ``tau`` included). Timings cover the tree
 search only: building the sampler from a heatmap (per map, once; reported as
-``setup_time``), JIT compilation (once per process, :func:`warmup`) and the reference-length
+``setup_time``), allocating the tree's arrays (per planner, reused; as OMPL's ``setup()``),
+seeding, JIT compilation (once per process, :func:`warmup`) and the reference-length
 computation (an oracle, not part of planning) are outside the timed region. With
 ``straight_first``, a free start-goal segment that meets the stop rule is the answer: the run's
-time is that one segment test. A sampler can be built once with :func:`make_sampler` and
-passed to many :func:`plan` calls.
+time is that one segment test (:mod:`.run`).
 """
 
 from __future__ import annotations
 
-import dataclasses
 import functools
 import logging
 import math
+import numbers
 import time
 
 import numpy as np
 
 from vnrrt.grid import GridError, as_occupancy, as_point
-from vnrrt.planners import core
-from vnrrt.planners.collision import point_free, polyline_length, segment_free
+from vnrrt.planners import core, run
+from vnrrt.planners.collision import segment_free
 from vnrrt.planners.config import PLANNERS, PlannerConfig
 from vnrrt.planners.reference import reference_length as compute_reference
-from vnrrt.planners.result import Milestone, PlanResult
+from vnrrt.planners.result import PlanResult
 from vnrrt.planners.samplers import Sampler, heatmap_sampler, rng_state, uniform_sampler
 
 log = logging.getLogger(__name__)
 
-FIRST_CHUNK, MAX_CHUNK = 64, 4096  # iterations per compiled call; budgets checked between
-FIRST_CAPACITY = 4096  # tree nodes allocated first; doubled when full (up to the budget)
-
-
-def make_sampler(
-    planner: str, shape: tuple[int, int], heatmap=None, tau=None, mix: float = 0.5
-) -> Sampler:
-    """The sampler of ``planner`` for an ``(H, W)`` map (see :mod:`.samplers`)."""
-    if planner not in PLANNERS:
-        raise ValueError(f"unknown planner {planner!r}; choose from {PLANNERS}")
-    if planner == "rrt_star":
-        if heatmap is not None:
-            raise ValueError("rrt_star samples uniformly and takes no heatmap")
-        return uniform_sampler(shape)
-    if heatmap is None:
-        raise ValueError(f"{planner} needs a heatmap of shape {tuple(shape)}")
-    if planner == "m_vnrrt_star":
-        if tau is None or not math.isfinite(tau):
-            raise ValueError(f"m_vnrrt_star needs a finite mask threshold tau, got {tau!r}")
-        return heatmap_sampler(heatmap, shape, mix, float(tau))
-    if tau is not None:
-        raise ValueError(f"{planner} takes no tau (only m_vnrrt_star masks its heatmap)")
-    return heatmap_sampler(heatmap, shape, mix)
-
-
+DEFAULT = PlannerConfig()
 SAMPLER_KINDS = {
     "rrt_star": "uniform",
     "nrrt_star": "heatmap",
@@ -64,48 +42,236 @@ SAMPLER_KINDS = {
 }
 
 
-def check_sampler(
-    sampler: Sampler, planner: str, shape: tuple[int, int], heatmap=None, tau=None
-) -> None:
-    """Raise ``ValueError`` unless ``sampler`` is what ``planner`` samples from on a map of
-    ``shape`` (a prebuilt sampler replaces ``heatmap`` and ``tau``)."""
+def _known(planner: str) -> None:
     if planner not in PLANNERS:
         raise ValueError(f"unknown planner {planner!r}; choose from {PLANNERS}")
-    if heatmap is not None or tau is not None:
-        raise ValueError("give either a prebuilt sampler or heatmap/tau, not both")
-    if sampler.kind != SAMPLER_KINDS[planner]:
-        raise ValueError(
-            f"{planner} samples from a {SAMPLER_KINDS[planner]} sampler, got a {sampler.kind} one"
-        )
+
+
+def _config(config: PlannerConfig | None) -> PlannerConfig:
+    if config is None:
+        return DEFAULT
+    if not isinstance(config, PlannerConfig):
+        raise TypeError(f"config must be a PlannerConfig, got {type(config).__name__}")
+    config.validate()  # remembered: a frozen config is checked once
+    return config
+
+
+def make_sampler(
+    planner: str, shape: tuple[int, int], heatmap=None, config: PlannerConfig | None = None
+) -> Sampler:
+    """The sampler of ``planner`` for an ``(H, W)`` map (see :mod:`.samplers`), built with
+    ``config.mix`` and, for M-VNRRT*, ``config.tau``."""
+    _known(planner)
+    cfg = _config(config)
+    if planner == "rrt_star":
+        if heatmap is not None:
+            raise ValueError("rrt_star samples uniformly and takes no heatmap")
+        return uniform_sampler(shape)
+    if heatmap is None:
+        raise ValueError(f"{planner} needs a heatmap of shape {tuple(shape)}")
+    tau = cfg.tau if planner == "m_vnrrt_star" else None
+    return heatmap_sampler(heatmap, shape, cfg.mix, tau)
+
+
+def check_sampler(
+    sampler: Sampler, planner: str, shape: tuple[int, int], config: PlannerConfig
+) -> None:
+    """Raise ``ValueError`` unless ``sampler`` is what ``planner`` samples from on a map of
+    ``shape`` with ``config`` (its kind, shape, ``mix`` and, when masked, ``tau``)."""
+    want = SAMPLER_KINDS[planner]
+    if sampler.kind != want:
+        raise ValueError(f"{planner} samples from a {want} sampler, got a {sampler.kind} one")
     if tuple(sampler.shape) != tuple(shape):
         raise GridError(f"sampler is for shape {sampler.shape}, the grid has shape {shape}")
+    if want != "uniform" and sampler.mix != config.mix:
+        raise ValueError(f"sampler was built with mix={sampler.mix}, the config has {config.mix}")
+    if want == "masked" and sampler.tau != config.tau:
+        raise ValueError(f"sampler was built with tau={sampler.tau}, the config has {config.tau}")
 
 
-def _check_endpoint(occ: np.ndarray, point, name: str) -> tuple[float, float]:
-    x, y = as_point(occ, point, name)
-    if not point_free(occ, (x, y)):
-        raise GridError(f"{name} {(x, y)} touches an obstacle cell or the map border")
-    return x, y
+def _occupancy(grid) -> np.ndarray:
+    """``grid`` as the core reads it: a C-contiguous 2-D uint8 array (at least 2x2) is used as
+    it is (nonzero = obstacle, no copy); anything else goes through :func:`as_occupancy`."""
+    if (
+        isinstance(grid, np.ndarray)
+        and grid.dtype == np.uint8
+        and grid.ndim == 2
+        and min(grid.shape) >= 2
+        and grid.flags.c_contiguous
+    ):
+        return grid
+    return as_occupancy(grid)
 
 
-def _params(cfg: PlannerConfig, occ: np.ndarray, start, goal) -> core.Params:
-    """The core's settings of a run (:class:`vnrrt.planners.core.Params`)."""
-    gamma = cfg.gamma
-    if gamma is None:  # RRT* bound 2 (1 + 1/d)^(1/d) (free area / unit-ball area)^(1/d), d=2
-        gamma = 2.0 * math.sqrt(1.5) * math.sqrt(np.count_nonzero(occ == 0) / math.pi)
-    return core.Params(
-        eta=float(cfg.eta),
-        gamma=float(gamma) * cfg.gamma_factor if cfg.radius_mode == "shrinking" else 0.0,
-        radius=float(cfg.fixed_radius),
-        goal_radius=float(cfg.eta if cfg.goal_radius is None else cfg.goal_radius),
-        sx=float(start[0]),
-        sy=float(start[1]),
-        gx=float(goal[0]),
-        gy=float(goal[1]),
-        min_spacing=float(cfg.min_spacing),
-        bucket=max(min(cfg.eta, max(occ.shape)) / 2, 1.0),  # an unlimited step: the map
-        informed=bool(cfg.informed),
-    )
+def _endpoint(occ: np.ndarray, point, name: str) -> tuple[float, float]:
+    """``point`` as floats ``(x, y)``: finite, in a free cell, touching no obstacle or border."""
+    try:
+        x, y = point
+        x, y = float(x), float(y)
+    except (TypeError, ValueError):
+        x = y = math.nan
+    if math.isfinite(x) and math.isfinite(y) and segment_free(occ, x, y, x, y):
+        return x, y
+    as_point(occ, point, name)  # names a malformed point, one outside, one in an obstacle
+    raise GridError(f"{name} {(x, y)} touches an obstacle cell or the map border")
+
+
+def _seed(seed) -> None:
+    if type(seed) is int and seed >= 0:  # the common case, checked fast
+        return
+    parts = seed if isinstance(seed, tuple | list) else (seed,)
+    if not all(isinstance(s, numbers.Integral) and s >= 0 for s in parts):
+        raise ValueError(f"seed must be an int >= 0 or a tuple of them, got {seed!r}")
+
+
+class Planner:
+    """One of the paper's RRT* variants set up for one map, as OMPL's ``setup()``: the grid
+    validated, the sampler built and the settings checked once; :meth:`solve` answers a
+    query (start, goal, stop rule, seed) at a time, reusing the tree's arrays from one query
+    to the next (so one solve at a time: not for concurrent use from several threads).
+
+    Args:
+        grid: ``(H, W)`` bool/int occupancy, nonzero = obstacle, indexed ``grid[y, x]``; a
+            C-contiguous uint8 array is read in place (do not change it while in use).
+        planner: ``'rrt_star'`` (uniform), ``'nrrt_star'`` / ``'vnrrt_star'`` (heatmap
+            sampler, Algorithm 2) or ``'m_vnrrt_star'`` (heatmap masked below ``config.tau``).
+        heatmap: ``(H, W)`` non-negative sampling weights, needed by all but RRT*.
+        config: every setting (default :class:`PlannerConfig`).
+        sampler: a sampler already built by :func:`make_sampler` for this planner, map and
+            config (then no ``heatmap``); checked against them.
+
+    Raises:
+        GridError: malformed grid, heatmap of the wrong shape or values.
+        ValueError: unknown planner, a sampler that does not match, bad settings.
+    """
+
+    def __init__(
+        self,
+        grid: np.ndarray,
+        planner: str = "rrt_star",
+        *,
+        heatmap: np.ndarray | None = None,
+        config: PlannerConfig | None = None,
+        sampler: Sampler | None = None,
+    ):
+        _known(planner)
+        self.planner, self.config = planner, _config(config)
+        self.occ = _occupancy(grid)
+        self.setup_time = 0.0
+        if sampler is None:
+            t0 = time.perf_counter()
+            sampler = make_sampler(planner, self.occ.shape, heatmap, self.config)
+            self.setup_time = time.perf_counter() - t0
+        elif heatmap is not None:
+            raise ValueError("give either a prebuilt sampler or a heatmap, not both")
+        else:
+            check_sampler(sampler, planner, self.occ.shape, self.config)
+        self.sampler = sampler
+        cfg = self.config
+        budget = run.Budget(cfg.max_iterations, cfg.max_seconds, cfg.trace_capacity)
+        bucket = max(min(cfg.eta, max(self.occ.shape)) / 2, 1.0)  # an unlimited step: the map
+        self._work = run.Workspace(self.occ.shape, bucket, budget)
+
+    @functools.cached_property
+    def draws(self) -> core.Draws:
+        """The sampler as the core reads it."""
+        s = self.sampler
+        cdf = s.cdf if s.cdf.size else np.zeros(1)
+        return core.Draws(float(s.draw_mix), cdf, max(s.last, 0))
+
+    @functools.cached_property
+    def gamma(self) -> float:
+        """The shrinking-radius constant: ``config.gamma_factor`` x (``config.gamma``, or the
+        RRT* bound ``2 (1 + 1/d)^(1/d) (free area / unit-ball area)^(1/d)``, d = 2, of this
+        map)."""
+        factor = float(self.config.gamma_factor)
+        if self.config.gamma is not None:
+            return factor * float(self.config.gamma)
+        free = self.occ.size - np.count_nonzero(self.occ)
+        return factor * 2.0 * math.sqrt(1.5) * math.sqrt(free / math.pi)
+
+    def solve(
+        self,
+        start,
+        goal,
+        *,
+        stop: str = "initial",
+        reference_length: float | None = None,
+        seed=0,
+        milestones: tuple[float, ...] = (),
+        keep_tree: bool = False,
+    ) -> PlanResult:
+        """Plan from ``start`` to ``goal``.
+
+        Args:
+            start, goal: continuous points ``(x, y)`` in pixels, in free cells and not
+                touching an obstacle or the map border.
+            stop: ``'initial'`` (first solution) or ``'optimal'`` (cost <= (1 + eps) x ref).
+            reference_length: reference for ``'optimal'``; None computes
+                ``config.reference`` (A* length by default) between the cells of the endpoints.
+            seed: int >= 0 or tuple of them, seeding the sampler (same seed, same result).
+            milestones: extra cost bounds (pixels) whose first-reach time is recorded.
+            keep_tree: also return the tree (points and parents) for drawing.
+
+        Returns:
+            A :class:`PlanResult`; hitting an iteration or time budget gives ``success=False``.
+
+        Raises:
+            GridError: bad start or goal.
+            NoPathError: the A* reference is needed and start and goal are not connected.
+            ValueError: unknown stop rule, bad reference length or seed.
+        """
+        start = _endpoint(self.occ, start, "start")
+        goal = _endpoint(self.occ, goal, "goal")
+        if stop not in ("initial", "optimal"):
+            raise ValueError(f"unknown stop rule {stop!r}; use 'initial' or 'optimal'")
+        _seed(seed)
+        cfg = self.config
+        if reference_length is None and stop == "optimal":
+            reference_length = compute_reference(self.occ, start, goal, cfg.reference)
+        if reference_length is not None and not (
+            math.isfinite(reference_length) and reference_length >= 0
+        ):
+            raise ValueError(f"reference_length must be finite and >= 0, got {reference_length}")
+        target = None if stop == "initial" else (1.0 + cfg.eps) * reference_length
+        bounds = tuple(float(m) for m in milestones) if milestones else ()
+        query = run.Query(start, goal, target, bounds, keep_tree, reference_length,
+                          self.setup_time, self.sampler.fallback_uniform)  # fmt: skip
+        warmup()
+        result = self._run(query, seed)
+        if log.isEnabledFor(logging.DEBUG):
+            log.debug("%s", result.summary())
+        return result
+
+    def _run(self, query: run.Query, seed) -> PlanResult:
+        """The timed run of a validated query (:mod:`.run`)."""
+        d, spent = run.straight_test(self.occ, query) if self.config.straight_first else (
+            -1.0, 0.0)  # fmt: skip
+        if d >= 0 and (query.target is None or d <= query.target):
+            return run.straight_result(self.planner, query, d, spent)
+        return run.search(self.occ, query, planner=self.planner, params=self._params(query),
+                          draws=self.draws, rng=rng_state(seed), work=self._work,
+                          straight=d >= 0, spent=spent)  # fmt: skip
+
+    def _params(self, query: run.Query) -> core.Params:
+        """The core's settings of a run (:class:`vnrrt.planners.core.Params`)."""
+        cfg = self.config
+        return core.Params(
+            eta=float(cfg.eta),
+            gamma=self.gamma if cfg.radius_mode == "shrinking" else 0.0,
+            radius=float(cfg.fixed_radius),
+            goal_radius=float(cfg.eta if cfg.goal_radius is None else cfg.goal_radius),
+            sx=query.start[0],
+            sy=query.start[1],
+            gx=query.goal[0],
+            gy=query.goal[1],
+            min_spacing=float(cfg.min_spacing),
+            bucket=self._work.bucket,
+            informed=bool(cfg.informed),
+            refine=float(cfg.refine),
+            pull_parents=bool(cfg.pull_parents),
+            refine_branches=float(cfg.refine_branches),
+        )
 
 
 def plan(
@@ -113,211 +279,29 @@ def plan(
     start,
     goal,
     planner: str = "rrt_star",
+    *,
     heatmap: np.ndarray | None = None,
-    tau: float | None = None,
+    config: PlannerConfig | None = None,
+    sampler: Sampler | None = None,
     stop: str = "initial",
     reference_length: float | None = None,
     seed=0,
-    config: PlannerConfig | None = None,
     milestones: tuple[float, ...] = (),
     keep_tree: bool = False,
-    sampler: Sampler | None = None,
-    **overrides,
 ) -> PlanResult:
-    """Plan from ``start`` to ``goal`` with one of the paper's RRT* variants.
+    """Plan once from ``start`` to ``goal``: ``Planner(grid, planner, heatmap=heatmap,
+    config=config, sampler=sampler).solve(start, goal, stop=stop, ...)``.
 
-    Args:
-        grid: ``(H, W)`` bool/int occupancy, nonzero = obstacle, indexed ``grid[y, x]``.
-        start, goal: continuous points ``(x, y)`` in pixels, in free cells and not touching
-            an obstacle or the map border.
-        planner: ``'rrt_star'`` (uniform), ``'nrrt_star'`` / ``'vnrrt_star'`` (heatmap
-            sampler, Algorithm 2) or ``'m_vnrrt_star'`` (heatmap masked below ``tau``).
-        heatmap: ``(H, W)`` non-negative sampling weights, needed by all but RRT*.
-        tau: mask threshold for M-VNRRT* (defaults to ``config.tau``).
-        stop: ``'initial'`` (first solution) or ``'optimal'`` (cost <= (1 + eps) x ref).
-        reference_length: reference for ``'optimal'``; None computes ``config.reference``
-            (A* length by default) between the cells containing start and goal.
-        seed: int or tuple of ints seeding the sampler (same seed, same result).
-        config: settings (default :class:`PlannerConfig`); ``overrides`` replace fields,
-            e.g. ``eta=5.0, max_seconds=2``.
-        milestones: extra cost bounds (pixels) whose first-reach time is recorded.
-        keep_tree: also return the tree (points and parents) for drawing.
-        sampler: a sampler already built by :func:`make_sampler` for this planner and map
-            (then ``heatmap`` and ``tau`` are not given); saves rebuilding it per run.
-
-    Returns:
-        A :class:`PlanResult`; hitting an iteration or time budget gives ``success=False``.
-
-    Raises:
-        GridError: malformed grid, bad start/goal, heatmap of the wrong shape or values.
-        NoPathError: the A* reference is needed and start and goal are not connected.
-        ValueError: unknown planner or stop rule, bad settings.
-    """
-    cfg = (config or PlannerConfig()).replace(**overrides)
-    occ = as_occupancy(grid)
-    start = _check_endpoint(occ, start, "start")
-    goal = _check_endpoint(occ, goal, "goal")
-    if stop not in ("initial", "optimal"):
-        raise ValueError(f"unknown stop rule {stop!r}; use 'initial' or 'optimal'")
-    if planner == "m_vnrrt_star" and tau is None and sampler is None:
-        tau = cfg.tau
-    t0 = time.perf_counter()
-    if sampler is None:
-        sampler = make_sampler(planner, occ.shape, heatmap, tau, cfg.mix)
-    else:
-        check_sampler(sampler, planner, occ.shape, heatmap, tau)
-    setup = time.perf_counter() - t0
-    if reference_length is None and stop == "optimal":
-        reference_length = compute_reference(occ, start, goal, cfg.reference)
-    if reference_length is not None and not (
-        math.isfinite(reference_length) and reference_length >= 0
-    ):
-        raise ValueError(f"reference_length must be finite and >= 0, got {reference_length}")
-    target = None if stop == "initial" else (1.0 + cfg.eps) * reference_length
-    warmup()
-    result = _timed(occ, start, goal, planner, sampler, target, milestones, seed, cfg, keep_tree)
-    result = dataclasses.replace(result, reference_length=reference_length, setup_time=setup)
-    if log.isEnabledFor(logging.DEBUG):
-        log.debug("%s", result.summary())
-    return result
-
-
-class _Run:
-    """The state of one run: tree, scratch buffers, counters and trace (:mod:`.core`)."""
-
-    def __init__(self, capacity: int, shape: tuple[int, int], bucket: float, trace: int):
-        self.tree = core.new_tree(capacity, shape, bucket)
-        self.scratch = core.new_scratch(capacity)
-        self.counters = core.new_counters()
-        self.trace = core.Trace(np.empty(trace, np.int64), np.empty(trace))
-
-    def enlarge(self, capacity: int) -> None:
-        """Room for ``capacity`` nodes, the tree kept."""
-        self.tree = core.enlarge(self.tree, capacity)
-        self.scratch = core.new_scratch(capacity)
-
-    @property
-    def capacity(self) -> int:
-        return len(self.tree.cost)
-
-
-def _timed(occ, start, goal, planner, sampler, target, milestones, seed, cfg, keep_tree):
-    """Plan on validated inputs; ``target`` None = first solution. The seed's generator, the
-    core's settings and the stop bounds are set up first; the timed region is the run."""
-    bounds = tuple(float(m) for m in milestones)
-    wanted = {math.inf, *bounds, *([] if target is None else [target])}
-    stops = np.array(sorted(wanted, reverse=True))
-    rng = rng_state(seed)
-    p = _params(cfg, occ, start, goal)
-    cdf = sampler.cdf if sampler.cdf.size else np.zeros(1)
-    draws = core.Draws(float(sampler.mix), cdf, max(sampler.last, 0))
-    t0 = time.perf_counter()
-    straight = cfg.straight_first and segment_free(occ, p.sx, p.sy, p.gx, p.gy)
-    found = time.perf_counter() - t0
-    answered = straight and (target is None or math.dist(start, goal) <= target)
-    capacity = 2 if answered else min(cfg.max_iterations + 2, FIRST_CAPACITY)  # root and goal
-    run = _Run(capacity, occ.shape, p.bucket, cfg.trace_capacity)
-    _start(run, occ, p, stops, straight)
-    if answered and _solved(run, target):  # known after one segment test (see _solved_clock)
-        clock = _solved_clock(found)
-    else:
-        clock = functools.partial(_since, t0)
-    reason, times, iters = _drive(run, occ, draws, p, rng, stops, target, cfg, clock)
-    elapsed = clock()
-    reached = {b: (float(t), int(i)) for b, t, i in zip(stops, times, iters, strict=True)}
-    result = _result(run, planner, reason, reached, elapsed, keep_tree)
-    extra = tuple(Milestone(b, *reached[b]) for b in bounds)
-    return dataclasses.replace(
-        result, target_cost=target, milestones=extra, fallback_uniform=sampler.fallback_uniform
-    )
-
-
-def _since(t0: float) -> float:
-    """Seconds since ``t0`` (``time.perf_counter``): the clock of a run."""
-    return time.perf_counter() - t0
-
-
-def _solved_clock(found: float):
-    """The clock of a run answered by the straight segment: a free start-goal segment that
-    meets the stop rule is the exact optimum, known after the one segment test at ``found``
-    seconds; the two-node tree that records it is bookkeeping, built (like the result) after
-    the clock has stopped, so the time stays proportional to the work done."""
-    return lambda: found
-
-
-def _solved(run: _Run, target: float | None) -> bool:
-    """Whether the goal is in the tree at a cost meeting the stop bound (None: any cost)."""
-    g = int(run.counters.goal[0])
-    return g >= 0 and (target is None or run.tree.cost[g] <= target)
-
-
-def _start(run: _Run, occ, p: core.Params, stops, straight: bool) -> None:
-    """The root at the start; the goal joins it when it is within reach and visible, or at
-    any distance when the straight segment is known to be free (``straight``: the optimum)."""
-    first = p._replace(goal_radius=math.inf) if straight else p
-    core.plant(occ, run.tree, run.counters, run.scratch.stack, run.trace, first, stops)
-
-
-def _drive(run, occ, draws, p, rng, stops, target, cfg, clock):
-    """Grow the planted tree (:func:`_start`) in compiled chunks until the stop rule or a
-    budget is met.
-
-    Returns ``(stop_reason, times, iterations)``: per entry of ``stops`` (decreasing cost
-    bounds), the time (``clock()``, s since the run's start) and iteration at which it was
-    first reached.
-    """
-    c = run.counters
-    times, iters = np.full(len(stops), math.nan), np.full(len(stops), -1, np.int64)
-    chunk, passed, status = FIRST_CHUNK, 0, core.RUNNING
-    while True:
-        now = clock()
-        times[passed : c.milestone[0]] = now
-        iters[passed : c.milestone[0]] = c.iters[0]
-        passed = c.milestone[0]
-        if _solved(run, target):
-            return "solved", times, iters
-        if status == core.TREE_FULL:
-            if run.capacity >= cfg.max_iterations + 2:  # root, goal and a node per iteration
-                raise RuntimeError(f"tree of {run.capacity} nodes full before the budget")
-            run.enlarge(min(2 * run.capacity, cfg.max_iterations + 2))
-        if c.iters[0] >= cfg.max_iterations:
-            return "max_iterations", times, iters
-        if now >= cfg.max_seconds:
-            return "max_seconds", times, iters
-        n = min(chunk, cfg.max_iterations - int(c.iters[0]))
-        status = core.grow(occ, run.tree, run.scratch, c, run.trace, rng, draws, stops, p, n)
-        chunk = min(2 * chunk, MAX_CHUNK)
-
-
-def _result(run: _Run, planner, reason, reached, elapsed, keep_tree) -> PlanResult:
-    """Assemble a :class:`PlanResult` from a finished run (stop-rule fields left empty)."""
-    c, tree = run.counters, run.tree
-    n, g, k = int(c.nodes[0]), int(c.goal[0]), int(c.trace_len[0])
-    path = core.branch(tree.links, tree.pts, g) if g >= 0 else np.zeros((0, 2))
-    cost = polyline_length(path) if g >= 0 else math.inf
-    trace_it, trace_cost = run.trace.iters[:k].copy(), run.trace.costs[:k].copy()
-    if k and trace_cost[-1] != tree.cost[g]:
-        trace_it = np.append(trace_it, c.iters[0])
-        trace_cost = np.append(trace_cost, tree.cost[g])
-    first_time, first_iter = reached[math.inf]
-    return PlanResult(
-        planner=planner,
-        success=reason == "solved",
-        stop_reason=reason,
-        path=path,
-        cost=cost,
-        iterations=int(c.iters[0]),
-        tree_size=n,
-        collision_checks=int(c.checks[0]),
-        time_to_first=first_time,
-        time_to_stop=elapsed,
-        first_cost=float(trace_cost[0]) if k else math.inf,
-        first_iteration=first_iter,
-        trace_iterations=trace_it,
-        trace_costs=trace_cost,
-        tree_points=tree.pts[:n].copy() if keep_tree else None,
-        tree_parents=tree.links[:n, core.PARENT].copy() if keep_tree else None,
-    )
+    ``grid`` ``(H, W)`` occupancy (nonzero = obstacle, ``grid[y, x]``); ``start``, ``goal``
+    continuous ``(x, y)`` pixels; ``planner`` one of :data:`PLANNERS` (all but RRT* sample
+    ``heatmap``, or a prebuilt ``sampler``); every setting in ``config`` (default
+    :class:`PlannerConfig`; :data:`FASTEST` our fastest); ``stop`` ``'initial'`` or
+    ``'optimal'`` (cost <= (1 + eps) x ``reference_length``, None: ``config.reference``
+    computed); ``seed`` an int >= 0 or a tuple of them. Arguments and errors: :class:`Planner`
+    and :meth:`Planner.solve`. Returns a :class:`PlanResult`."""
+    p = Planner(grid, planner, heatmap=heatmap, config=config, sampler=sampler)
+    return p.solve(start, goal, stop=stop, reference_length=reference_length, seed=seed,
+                   milestones=milestones, keep_tree=keep_tree)  # fmt: skip
 
 
 @functools.cache
@@ -326,11 +310,12 @@ def warmup() -> None:
     reported timings exclude JIT compilation."""
     occ = np.zeros((8, 8), np.uint8)
     occ[2:6, 4] = 1
-    cfg = PlannerConfig(max_iterations=200)
     heat = np.ones((8, 8))
     for planner, hm in (("rrt_star", None), ("vnrrt_star", heat)):
-        sampler = make_sampler(planner, occ.shape, hm)
         for informed in (False, True):
-            c = cfg.replace(informed=informed)
-            _timed(occ, (1.5, 3.5), (6.5, 3.5), planner, sampler, 0.0, (), 0, c, False)
+            cfg = PlannerConfig(max_iterations=200, informed=informed)
+            p = Planner(occ, planner, heatmap=hm, config=cfg)
+            query = run.Query((1.5, 3.5), (6.5, 3.5), 0.0, (), False, None, 0.0, False)
+            p._run(query, 0)
+    core.straight_cost(occ, 0.5, 0.5, 1.5, 1.5)
     log.debug("planner kernels compiled")

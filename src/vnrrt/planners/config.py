@@ -21,7 +21,7 @@ class PlannerConfigError(ValueError):
     """A planner setting is invalid; the message names it."""
 
 
-@dataclass
+@dataclass(frozen=True)
 class PlannerConfig:
     """RRT* core, samplers, stop rules and budgets (paper, Background and VertexNet RRT*).
 
@@ -38,7 +38,7 @@ class PlannerConfig:
             collision-free straight segment; ``None`` means ``eta``; ``.inf``: any node
             that sees the goal.
         mix: probability of a heatmap draw in NRRT*/VNRRT*/M-VNRRT* (Algorithm 2: 0.5).
-        tau: default mask threshold of M-VNRRT* when ``plan`` gets none.
+        tau: mask threshold of M-VNRRT* (pixels with heatmap value below it get no weight).
         taus: thresholds evaluated for M-VNRRT* (paper: 0.5, 0.9, 0.99).
         eps: stop rule ``optimal``: best cost <= (1 + eps) x reference length.
         reference: ``'astar'`` (paper: 8-connected A* length), ``'any_angle'`` (the exact
@@ -54,8 +54,20 @@ class PlannerConfig:
             (:mod:`vnrrt.planners.core`). Off in the paper's protocol.
         straight_first: try the straight start-goal segment first (any length): when it is
             free it is the optimum and the run ends at once. Off in the paper's protocol.
+        refine: share of the iterations, once a solution exists, that are path-refinement
+            moves instead of samples (:mod:`vnrrt.planners.refine`: shortcut or move a vertex
+            of the best path); 0 (the paper's protocol) disables it.
+        pull_parents: a new node's parent is the furthest ancestor of the chosen parent that
+            sees it (Theta*'s any-angle parent), so branches are pulled taut round obstacle
+            corners as they grow. Off in the paper's protocol.
+        refine_branches: share of the refinement moves made on the branch of a random tree
+            node that could still lead to a better solution, rather than on the best path.
         max_iterations, max_seconds: budgets; hitting one is a recorded failure.
         trace_capacity: most points kept in the sparse cost-versus-iteration trace.
+
+    Frozen: a config is changed by :meth:`replace`, which validates the copy, so a config
+    that passed :meth:`validate` stays valid (the check is remembered, and repeated calls
+    cost nothing).
     """
 
     eta: float = 10.0
@@ -72,12 +84,17 @@ class PlannerConfig:
     min_spacing: float = 0.5
     informed: bool = False
     straight_first: bool = False
+    refine: float = 0.0
+    pull_parents: bool = False
+    refine_branches: float = 0.0
     max_iterations: int = 200_000
     max_seconds: float = 30.0
     trace_capacity: int = 1024
 
     def validate(self) -> None:
         """Raise :class:`PlannerConfigError` naming the first invalid value."""
+        if self.__dict__.get("_valid"):
+            return
         for name in ("fixed_radius", "max_seconds"):
             v = getattr(self, name)
             self._check(name, _finite(v) and v > 0, "> 0")
@@ -92,7 +109,10 @@ class PlannerConfig:
         self._check(
             "goal_radius", g is None or g == math.inf or (_finite(g) and g > 0), "null, > 0 or .inf"
         )
-        for name in ("informed", "straight_first"):
+        for name in ("refine", "refine_branches"):
+            v = getattr(self, name)
+            self._check(name, _finite(v) and 0.0 <= v <= 1.0, "in [0, 1]")
+        for name in ("informed", "straight_first", "pull_parents"):
             self._check(name, isinstance(getattr(self, name), bool), "true or false")
         self._check("radius_mode", self.radius_mode in RADIUS_MODES, f"one of {RADIUS_MODES}")
         self._check("reference", self.reference in REFERENCES, f"one of {REFERENCES}")
@@ -106,6 +126,7 @@ class PlannerConfig:
         self._check("trace_capacity", ok, "an integer >= 2")
         self._check("tau", _finite(self.tau), "finite")
         self._check("taus", all(_finite(t) for t in self.taus), "finite values")
+        object.__setattr__(self, "_valid", True)  # not a field: eq, repr and replace ignore it
 
     def _check(self, name: str, ok: bool, why: str) -> None:
         if not ok:
@@ -135,3 +156,14 @@ def _number(v) -> bool:
 
 def _finite(v) -> bool:
     return isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)
+
+
+FASTEST = PlannerConfig(
+    eta=20.0,
+    goal_radius=math.inf,
+    informed=True,
+    straight_first=True,
+    refine=0.5,
+    pull_parents=True,
+    refine_branches=0.5,
+)  # our fastest settings (benchmarks/bench_planners.py's ``ours-best``), any planner

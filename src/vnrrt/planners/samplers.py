@@ -15,13 +15,16 @@ Informed sampling (:func:`informed_point`, used by the core once a solution exis
 ``informed`` is set) draws the same way but inside the ellipse of the points through which a
 shorter path can run.
 
-If no positive weight is left, the sampler falls back to uniform (``mix = 0``) and sets
-``fallback_uniform``. Randomness comes from a xoshiro256** generator whose 4-word
-``uint64`` state is seeded with :class:`numpy.random.SeedSequence`; no global state.
+If no positive weight is left, the sampler falls back to uniform (no heatmap draws) and sets
+``fallback_uniform``. Huge or tiny weights are scaled by a power of two before they are summed
+(the draws stay those of the given weights). Randomness comes from a xoshiro256** generator
+whose 4-word ``uint64`` state is seeded as :class:`numpy.random.SeedSequence` seeds it
+(:func:`vnrrt.planners.seeding.rng_state`); no global state.
 """
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -29,16 +32,9 @@ import numpy as np
 from numba import njit
 
 from vnrrt.grid import GridError
+from vnrrt.planners.seeding import rng_state
 
 _INV_2_53 = 1.0 / 9007199254740992.0
-
-
-def rng_state(seed) -> np.ndarray:
-    """Fresh xoshiro256** state ``(4,)`` uint64 derived from ``seed`` (int or int tuple)."""
-    state = np.random.SeedSequence(seed).generate_state(4, dtype=np.uint64)
-    if not state.any():  # the all-zero state is the one invalid xoshiro state
-        state[0] = 1
-    return state
 
 
 @njit(cache=True, inline="always")
@@ -62,16 +58,18 @@ def next_double(s: np.ndarray) -> float:
 
 @dataclass(frozen=True)
 class Sampler:
-    """A sampling distribution over an ``(H, W)`` map.
+    """A sampling distribution over an ``(H, W)`` map, and the settings it was built with.
 
     Attributes:
         kind: ``'uniform'``, ``'heatmap'`` or ``'masked'``.
-        mix: probability of a heatmap draw (0 for uniform or after a fallback).
+        mix: the probability of a heatmap draw it was built with (0 for uniform).
         cdf: ``(H*W,)`` float64 cumulative weights over flat pixels ``y * W + x``
-            (empty for uniform).
+            (empty for uniform or after a fallback), scaled by a power of two when the raw
+            total would overflow or lose precision (:func:`heatmap_sampler`).
         last: index of the last pixel with positive weight (-1 for uniform).
         shape: ``(H, W)`` of the map.
         fallback_uniform: True when a heatmap sampler had no positive weight left.
+        tau: the mask threshold of a masked sampler (None for the other kinds).
     """
 
     kind: str
@@ -80,11 +78,23 @@ class Sampler:
     last: int
     shape: tuple[int, int]
     fallback_uniform: bool = False
+    tau: float | None = None
+
+    @property
+    def draw_mix(self) -> float:
+        """Probability that a sample is a heatmap draw: ``mix``, or 0 without weights."""
+        return 0.0 if self.fallback_uniform or self.last < 0 else self.mix
 
 
 def uniform_sampler(shape: tuple[int, int]) -> Sampler:
     """Uniform sampler over the ``(H, W)`` map."""
-    return Sampler("uniform", 0.0, np.zeros(0), -1, (int(shape[0]), int(shape[1])))
+    return _uniform(int(shape[0]), int(shape[1]))
+
+
+@functools.lru_cache(maxsize=64)
+def _uniform(h: int, w: int) -> Sampler:
+    """One uniform sampler per map shape (it holds no weights: nothing to change)."""
+    return Sampler("uniform", 0.0, np.zeros(0), -1, (h, w))
 
 
 def heatmap_sampler(
@@ -110,12 +120,30 @@ def heatmap_sampler(
     if not 0.0 <= mix <= 1.0:
         raise ValueError(f"mix must be in [0, 1], got {mix}")
     weights = hm if tau is None else np.where(hm >= tau, hm, 0.0)
-    kind = "heatmap" if tau is None else "masked"
-    flat = weights.ravel()
+    kind, tau = ("heatmap", None) if tau is None else ("masked", float(tau))
+    flat = _in_range(weights.ravel())
     positive = np.flatnonzero(flat > 0)
     if positive.size == 0:
-        return Sampler(kind, 0.0, np.zeros(0), -1, tuple(shape), fallback_uniform=True)
-    return Sampler(kind, float(mix), np.cumsum(flat), int(positive[-1]), tuple(shape))
+        return Sampler(kind, float(mix), np.zeros(0), -1, tuple(shape), True, tau)
+    cdf = np.cumsum(flat)
+    if not math.isfinite(cdf[-1]):  # unreachable after _in_range; never sample from it
+        raise GridError(f"heatmap weights sum to {cdf[-1]}, not a finite total")
+    return Sampler(kind, float(mix), cdf, int(positive[-1]), tuple(shape), False, tau)
+
+
+SAFE_TOP = 2.0**960  # weights whose total stays within [2^-960, 2^960] are summed as given
+
+
+def _in_range(flat: np.ndarray) -> np.ndarray:
+    """``flat`` (finite, >= 0) scaled by a power of two when its total would overflow or
+    come near the subnormal range, so that the largest weight lies in [0.5, 1). A power of
+    two scales every sum exactly, so the draws are those of the given weights; weights whose
+    total stays in the safe range (every probability map) are returned as they are, and
+    their draws are bit-identical to an unscaled cumulative sum."""
+    top = float(flat.max()) if flat.size else 0.0
+    if top == 0.0 or (top >= 1.0 / SAFE_TOP and top * flat.size <= SAFE_TOP):
+        return flat
+    return np.ldexp(flat, -math.frexp(top)[1])
 
 
 @njit(cache=True, inline="always")
@@ -227,7 +255,7 @@ def draw(sampler: Sampler, n: int, seed=0, ellipse=None) -> np.ndarray:
         int(n),
         h,
         w,
-        sampler.mix,
+        sampler.draw_mix,
         cdf,
         max(sampler.last, 0),
         ellipse is not None,

@@ -1,0 +1,265 @@
+"""One planner run on validated inputs: the timed region of :meth:`vnrrt.planners.Planner.solve`.
+
+The clock starts before the straight start-goal segment is tested (when ``straight_first``)
+and stops when the stop rule or a budget is met. The tree's arrays are allocated (or emptied
+for reuse) before it starts, as OMPL's ``setup()`` is outside its ``solve()`` times; growing
+them is inside. A free straight segment that meets the stop rule is the exact optimum, known
+after that one segment test: its result (a two-node tree) is written after the clock has
+stopped, like every result. Otherwise the tree grows in compiled chunks of
+:func:`vnrrt.planners.core.grow`, budgets checked between chunks."""
+
+from __future__ import annotations
+
+import math
+import time
+from typing import NamedTuple
+
+import numpy as np
+
+from vnrrt.planners import core
+from vnrrt.planners import tree as nodes
+from vnrrt.planners.collision import polyline_length
+from vnrrt.planners.result import Milestone, PlanResult
+
+FIRST_CHUNK, MAX_CHUNK = 64, 4096  # iterations per compiled call; budgets checked between
+FIRST_CAPACITY = 4096  # tree nodes allocated first; doubled when full (up to the budget)
+
+
+class Query(NamedTuple):
+    """What one run is asked (lengths in pixels): start and goal ``(x, y)``, the stop bound
+    ``target`` (None: the first solution), the extra cost ``bounds`` whose first-reach is
+    recorded, whether the tree is returned, and the fields copied into the result."""
+
+    start: tuple[float, float]
+    goal: tuple[float, float]
+    target: float | None
+    bounds: tuple[float, ...]
+    keep_tree: bool
+    reference_length: float | None
+    setup_time: float
+    fallback_uniform: bool
+
+
+class Budget(NamedTuple):
+    """A run's budgets and trace size (:class:`vnrrt.planners.PlannerConfig`)."""
+
+    max_iterations: int
+    max_seconds: float
+    trace_capacity: int
+
+
+class Tree:
+    """The state of one growing run: tree, scratch buffers, counters and trace (:mod:`.core`)."""
+
+    def __init__(self, capacity: int, shape: tuple[int, int], bucket: float, trace: int):
+        self.tree = nodes.new_tree(capacity, shape, bucket)
+        self.scratch = nodes.new_scratch(capacity)
+        self.counters = nodes.new_counters()
+        self.trace = nodes.Trace(np.empty(trace, np.int64), np.empty(trace))
+        self._flatten()
+
+    def _flatten(self) -> None:
+        """The arrays as plain tuples, as :func:`vnrrt.planners.core.grow_flat` takes them."""
+        self.flat = tuple(self.tree), tuple(self.scratch), tuple(self.counters), tuple(self.trace)
+
+    def enlarge(self, capacity: int) -> None:
+        """Room for ``capacity`` nodes, the tree kept."""
+        self.tree = nodes.enlarge(self.tree, capacity)
+        self.scratch = nodes.new_scratch(capacity)
+        self._flatten()
+
+    @property
+    def capacity(self) -> int:
+        return len(self.tree.cost)
+
+    def solved(self, target: float | None) -> bool:
+        """Whether the goal is in the tree at a cost meeting ``target`` (None: any cost)."""
+        g = int(self.counters.goal[0])
+        return g >= 0 and (target is None or self.tree.cost[g] <= target)
+
+    def reset(self) -> None:
+        """Empty the tree, its arrays kept (a node's fields are written when it is added)."""
+        for count in self.counters:
+            count[0] = 0
+        self.counters.goal[0] = -1
+        self.tree.head.fill(-1)
+
+
+class Workspace:
+    """The arrays of the runs of one :class:`vnrrt.planners.Planner` on one map: allocated by
+    the first run (``FIRST_CAPACITY`` nodes, grown as needed), emptied and reused by the next
+    ones. One run at a time."""
+
+    def __init__(self, shape: tuple[int, int], bucket: float, budget: Budget):
+        self.shape, self.bucket, self.budget = shape, bucket, budget
+        self._tree: Tree | None = None
+
+    def fresh(self) -> Tree:
+        """An empty tree (newly allocated the first time)."""
+        if self._tree is None:
+            capacity = min(self.budget.max_iterations + 2, FIRST_CAPACITY)
+            self._tree = Tree(capacity, self.shape, self.bucket, self.budget.trace_capacity)
+        else:
+            self._tree.reset()
+        return self._tree
+
+
+def stop_bounds(query: Query) -> np.ndarray:
+    """The cost bounds the core reports passing, decreasing: ``inf`` (any solution), the
+    extra bounds and the stop bound."""
+    wanted = {math.inf, *query.bounds, *([] if query.target is None else [query.target])}
+    return np.array(sorted(wanted, reverse=True))
+
+
+def straight_test(occ: np.ndarray, query: Query) -> tuple[float, float]:
+    """The start-goal distance when the segment between them is free (-1 when blocked), and
+    the seconds the test took (the first part of a run's time)."""
+    t0 = time.perf_counter()
+    (sx, sy), (gx, gy) = query.start, query.goal
+    d = core.straight_cost(occ, sx, sy, gx, gy)
+    return d, time.perf_counter() - t0
+
+
+def straight_result(planner: str, query: Query, d: float, found: float) -> PlanResult:
+    """The result of a run answered after ``found`` seconds by the free straight segment of
+    length ``d``: the tree is the root and the goal joined to it (one segment test). The
+    cost is ``d``, equal to the polyline length of the path (both are libm's ``hypot``)."""
+    path = np.array((*query.start, *query.goal)).reshape(2, 2)
+    extra = tuple(Milestone(b, found, 0) if d <= b else Milestone(b) for b in query.bounds)
+    return PlanResult(
+        planner=planner,
+        success=True,
+        stop_reason="solved",
+        path=path,
+        cost=d,
+        iterations=0,
+        tree_size=2,
+        collision_checks=1,
+        time_to_first=found,
+        time_to_stop=found,
+        first_cost=d,
+        first_iteration=0,
+        trace_iterations=np.zeros(1, np.int64),
+        trace_costs=np.array([d]),
+        reference_length=query.reference_length,
+        target_cost=query.target,
+        milestones=extra,
+        fallback_uniform=query.fallback_uniform,
+        setup_time=query.setup_time,
+        tree_points=path.copy() if query.keep_tree else None,
+        tree_parents=np.array([-1, 0], np.int64) if query.keep_tree else None,
+    )
+
+
+def search(
+    occ: np.ndarray,
+    query: Query,
+    *,
+    planner: str,
+    params: core.Params,
+    draws: core.Draws,
+    rng: np.ndarray,
+    work: Workspace,
+    straight: bool,
+    spent: float = 0.0,
+) -> PlanResult:
+    """Grow a tree (in ``work``) from the start until the stop rule or a budget is met;
+    ``straight``: the start-goal segment is known to be free (the goal joins the root at
+    once); ``spent``: seconds of the run before this call (the straight-segment test)."""
+    stops = stop_bounds(query)
+    run = work.fresh()  # allocated (or emptied) before the clock starts, as OMPL's setup()
+    first = tuple(params._replace(goal_radius=math.inf) if straight else params)
+    tree, _, counters, trace = run.flat
+    t0 = time.perf_counter() - spent
+    core.plant_flat(occ, tree, counters, run.scratch.stack, trace, first, stops)
+    reason, times, iters = drive(run, occ, draws=draws, params=params, rng=rng, stops=stops,
+                                 target=query.target, budget=work.budget, t0=t0)  # fmt: skip
+    elapsed = time.perf_counter() - t0
+    reached = {b: (float(t), int(i)) for b, t, i in zip(stops, times, iters, strict=True)}
+    return result(run, planner, query, reason=reason, reached=reached, elapsed=elapsed)
+
+
+def drive(
+    run: Tree,
+    occ: np.ndarray,
+    *,
+    draws: core.Draws,
+    params: core.Params,
+    rng: np.ndarray,
+    stops: np.ndarray,
+    target: float | None,
+    budget: Budget,
+    t0: float,
+) -> tuple[str, list[float], list[int]]:
+    """Grow the planted tree in compiled chunks until the stop rule or a budget is met.
+
+    Returns ``(stop_reason, times, iterations)``: per entry of ``stops`` (decreasing cost
+    bounds), the time (s since ``t0``, ``time.perf_counter``) and iteration at which it was
+    first reached (NaN / -1: never).
+    """
+    c = run.counters
+    times, iters = [math.nan] * len(stops), [-1] * len(stops)
+    chunk, passed, status = FIRST_CHUNK, 0, core.RUNNING
+    draws_t, params_t = tuple(draws), tuple(params)
+    while True:
+        now = time.perf_counter() - t0
+        for m in range(passed, int(c.milestone[0])):
+            times[m], iters[m] = now, int(c.iters[0])
+        passed = int(c.milestone[0])
+        if run.solved(target):
+            return "solved", times, iters
+        if status == core.TREE_FULL:
+            if run.capacity >= budget.max_iterations + 2:  # root, goal and a node per iteration
+                raise RuntimeError(f"tree of {run.capacity} nodes full before the budget")
+            run.enlarge(min(2 * run.capacity, budget.max_iterations + 2))
+        if c.iters[0] >= budget.max_iterations:
+            return "max_iterations", times, iters
+        if now >= budget.max_seconds:
+            return "max_seconds", times, iters
+        n = min(chunk, budget.max_iterations - int(c.iters[0]))
+        status = core.grow_flat(occ, *run.flat, rng, draws_t, stops, params_t, n)
+        chunk = min(2 * chunk, MAX_CHUNK)
+
+
+def result(
+    run: Tree,
+    planner: str,
+    query: Query,
+    *,
+    reason: str,
+    reached: dict[float, tuple[float, int]],
+    elapsed: float,
+) -> PlanResult:
+    """The :class:`PlanResult` of a finished run; ``reached[bound] = (seconds, iteration)``."""
+    c, tree = run.counters, run.tree
+    n, g, k = int(c.nodes[0]), int(c.goal[0]), int(c.trace_len[0])
+    path = nodes.branch(tree.links, tree.pts, g) if g >= 0 else np.zeros((0, 2))
+    last = k and run.trace.costs[k - 1] != tree.cost[g]  # the final value, when not traced
+    trace_it, trace_cost = np.empty(k + last, np.int64), np.empty(k + last)
+    trace_it[:k], trace_cost[:k] = run.trace.iters[:k], run.trace.costs[:k]
+    if last:
+        trace_it[k], trace_cost[k] = c.iters[0], tree.cost[g]
+    first_time, first_iter = reached[math.inf]
+    return PlanResult(
+        planner=planner,
+        success=reason == "solved",
+        stop_reason=reason,
+        path=path,
+        cost=polyline_length(path) if g >= 0 else math.inf,
+        iterations=int(c.iters[0]),
+        tree_size=n,
+        collision_checks=int(c.checks[0]),
+        time_to_first=first_time,
+        time_to_stop=elapsed,
+        first_cost=float(trace_cost[0]) if k else math.inf,
+        first_iteration=first_iter,
+        trace_iterations=trace_it,
+        trace_costs=trace_cost,
+        reference_length=query.reference_length,
+        target_cost=query.target,
+        milestones=tuple(Milestone(b, *reached[b]) for b in query.bounds),
+        fallback_uniform=query.fallback_uniform,
+        setup_time=query.setup_time,
+        tree_points=tree.pts[:n].copy() if query.keep_tree else None,
+        tree_parents=tree.links[:n, nodes.PARENT].copy() if query.keep_tree else None,
+    )

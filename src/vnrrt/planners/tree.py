@@ -1,0 +1,197 @@
+"""The RRT* tree in preallocated arrays: nodes, parent/child links, costs, the bucket grid of
+:mod:`.spatial`, and the sparse best-cost trace (compiled with numba).
+
+Positions are continuous ``(x, y)`` pixels and costs path lengths in pixels from the root.
+The tree is kept as linked lists (:data:`PARENT`, :data:`CHILD`, :data:`NEXT`, :data:`PREV`
+columns of ``Tree.links``) so that re-parenting a node and shifting its subtree's costs
+(:func:`reparent`) need no search. The goal, once connected, is a leaf; its cost is the best
+solution cost.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+from numba import njit
+
+from vnrrt.planners import spatial
+
+PARENT, CHILD, NEXT, PREV = 0, 1, 2, 3  # columns of ``Tree.links``: the tree as linked lists
+TRACE_REL = 1e-4  # relative improvement that earns a new trace point
+
+
+class Tree(NamedTuple):
+    """The nodes of one RRT* run, capacity ``C``: ``pts`` (C, 2) float64 positions (x, y),
+    ``cost`` (C,) cost-to-come, ``links`` (C, 4) int64 parent / first child / next and
+    previous sibling (-1: none), ``bnext`` (C,) and ``head`` the bucket grid
+    (:mod:`.spatial`), ``step`` (C,) each node's radius of refinement moves (:mod:`.refine`)."""
+
+    pts: np.ndarray
+    cost: np.ndarray
+    links: np.ndarray
+    bnext: np.ndarray
+    step: np.ndarray
+    head: np.ndarray
+
+
+class Scratch(NamedTuple):
+    """Buffers of one iteration: the near set (indices, distances, costs through them,
+    segment checks 0 unknown / 1 free / 2 blocked) and a stack for subtree walks."""
+
+    near_idx: np.ndarray
+    near_d: np.ndarray
+    near_c: np.ndarray
+    near_ok: np.ndarray
+    stack: np.ndarray
+
+
+class Counters(NamedTuple):
+    """Mutable counts, each a (1,) int64 array: nodes in the tree, iterations (samples),
+    segment checks, the goal node (-1: none yet), trace points, milestones passed."""
+
+    nodes: np.ndarray
+    iters: np.ndarray
+    checks: np.ndarray
+    goal: np.ndarray
+    trace_len: np.ndarray
+    milestone: np.ndarray
+
+
+class Trace(NamedTuple):
+    """The sparse best-cost trace: ``iters`` (T,) int64 and ``costs`` (T,) float64."""
+
+    iters: np.ndarray
+    costs: np.ndarray
+
+
+def new_tree(capacity: int, shape: tuple[int, int], bucket: float) -> Tree:
+    """Empty node arrays for ``capacity`` nodes on an ``(H, W)`` map."""
+    c = int(capacity)
+    return Tree(
+        np.empty((c, 2)),
+        np.empty(c),
+        np.empty((c, 4), np.int64),
+        np.empty(c, np.int64),
+        np.empty(c),
+        spatial.new_buckets(shape, bucket),
+    )
+
+
+def new_scratch(capacity: int) -> Scratch:
+    c = int(capacity)
+    return Scratch(
+        np.empty(c, np.int64), np.empty(c), np.empty(c), np.empty(c, np.int8), np.empty(c, np.int64)
+    )
+
+
+def new_counters() -> Counters:
+    """Zero counts (views of one array), no goal node."""
+    buf = np.zeros(len(Counters._fields), np.int64)
+    c = Counters(*(buf[i : i + 1] for i in range(len(buf))))
+    c.goal[0] = -1
+    return c
+
+
+def enlarge(tree: Tree, capacity: int) -> Tree:
+    """The same tree in arrays for ``capacity`` nodes (memory grows with the work done)."""
+    n = len(tree.cost)
+    out = []
+    for arr in tree[:-1]:
+        new = np.empty((int(capacity), *arr.shape[1:]), arr.dtype)
+        new[:n] = arr
+        out.append(new)
+    return Tree(*out, tree.head)
+
+
+@njit(cache=True)
+def _link(links, i, parent):
+    """Make ``i`` the first child of ``parent`` (its own children are kept)."""
+    links[i, PARENT] = parent
+    links[i, PREV] = -1
+    first = links[parent, CHILD] if parent >= 0 else -1
+    links[i, NEXT] = first
+    if first >= 0:
+        links[first, PREV] = i
+    if parent >= 0:
+        links[parent, CHILD] = i
+
+
+@njit(cache=True)
+def add_node(tree, i, parent, x, y, c):
+    """Write node ``i`` at ``(x, y)`` with cost ``c`` as a new leaf under ``parent``."""
+    tree.pts[i, 0], tree.pts[i, 1], tree.cost[i] = x, y, c
+    tree.links[i, CHILD] = -1
+    _link(tree.links, i, parent)
+
+
+@njit(cache=True)
+def reparent(tree, stack, i, parent, c):
+    """Move node ``i`` under ``parent`` with new cost ``c``; shift its subtree's costs."""
+    links, cost = tree.links, tree.cost
+    prev, nxt = links[i, PREV], links[i, NEXT]
+    if prev >= 0:
+        links[prev, NEXT] = nxt
+    else:
+        links[links[i, PARENT], CHILD] = nxt
+    if nxt >= 0:
+        links[nxt, PREV] = prev
+    _link(links, i, parent)
+    delta = c - cost[i]
+    cost[i] = c
+    stack[0] = i
+    top = 1
+    while top > 0:  # propagate delta to every descendant
+        top -= 1
+        child = links[stack[top], CHILD]
+        while child >= 0:
+            cost[child] += delta
+            stack[top] = child
+            top += 1
+            child = links[child, NEXT]
+
+
+@njit(cache=True, inline="always")
+def best_cost(tree, counters):
+    """Cost of the best solution so far (``inf`` before the first)."""
+    g = counters.goal[0]
+    return tree.cost[g] if g >= 0 else np.inf
+
+
+@njit(cache=True)
+def record(counters, tree, trace, milestones):
+    """Append to the sparse trace; return True when the best cost passed a milestone.
+
+    ``milestones`` (M,) are cost bounds in decreasing order (``inf`` = any solution).
+    """
+    g = counters.goal[0]
+    if g < 0:
+        return False
+    c = tree.cost[g]
+    n = counters.trace_len[0]
+    if n == 0 or c < trace.costs[n - 1] * (1.0 - TRACE_REL):
+        n = min(n, trace.iters.shape[0] - 1)  # when full, the last point is overwritten
+        trace.iters[n], trace.costs[n] = counters.iters[0], c
+        counters.trace_len[0] = n + 1
+    m = counters.milestone[0]
+    hit = False
+    while m < milestones.shape[0] and c <= milestones[m]:
+        m += 1
+        hit = True
+    counters.milestone[0] = m
+    return hit
+
+
+@njit(cache=True)
+def branch(links: np.ndarray, pts: np.ndarray, node: int) -> np.ndarray:
+    """Positions ``(K, 2)`` (a new array) from the root to ``node`` following parent links."""
+    k, v = 0, node
+    while v >= 0:
+        k += 1
+        v = links[v, PARENT]
+    out = np.empty((k, 2))
+    v = node
+    for i in range(k - 1, -1, -1):
+        out[i, 0], out[i, 1] = pts[v, 0], pts[v, 1]
+        v = links[v, PARENT]
+    return out

@@ -1,0 +1,59 @@
+"""The benchmark's native OMPL harness (benchmarks/ompl_native): it builds against the system's
+libompl-dev and reports, on one map, a path whose length is within 1% of our exact optimum
+and that it stopped there (its cost threshold). Skipped where libompl-dev is absent."""
+
+import math
+import shutil
+
+import numpy as np
+import pytest
+from benchmarks import ompl_native
+
+from vnrrt.maps.named import named_map
+from vnrrt.planners import any_angle_path, polyline_length
+
+
+@pytest.fixture(scope="module")
+def binary():
+    try:
+        return ompl_native.build()
+    except ompl_native.HarnessError as err:
+        pytest.skip(f"native OMPL harness not buildable here ({err}); {ompl_native.INSTALL}")
+
+
+@pytest.mark.parametrize("planner", ["BITstar", "InformedRRTstar"])
+def test_the_harness_stops_within_one_percent_of_the_exact_optimum(binary, planner):
+    fm = named_map("open", 200)
+    s, e = tuple(fm.starts[0] + 0.5), tuple(fm.goals[0] + 0.5)
+    exact = any_angle_path(fm.grid, s, e)[1]
+    with ompl_native.Harness(binary, seed=3) as native:
+        native.set_map(fm.grid)
+        r = native.solve(planner, s, e, bound=1.01 * exact, limit=10.0)
+    assert 0 < r.first <= r.stop < 10.0 and r.setup > 0
+    np.testing.assert_allclose(r.path[[0, -1]], [s, e])
+    assert r.cost == pytest.approx(polyline_length(r.path), rel=1e-9)
+    # within 1% of our exact reference (OMPL checks states every 0.5 px, so it may cut a
+    # corner by a hair and come in below the exact optimum)
+    assert abs(r.cost / exact - 1) <= 0.01
+
+
+def test_a_query_before_any_map_is_an_error(binary):
+    with (
+        ompl_native.Harness(binary) as native,
+        pytest.raises(ompl_native.HarnessError, match="no map"),
+    ):
+        native.solve("BITstar", (1.5, 1.5), (5.5, 5.5), bound=10.0, limit=1.0)
+
+
+def test_without_a_compiler_the_build_says_how_to_install(monkeypatch, tmp_path):
+    monkeypatch.setattr(shutil, "which", lambda name: None)
+    with pytest.raises(ompl_native.HarnessError, match="apt-get install -y libompl-dev g\\+\\+"):
+        ompl_native.build(tmp_path)
+    assert not any(tmp_path.iterdir())
+
+
+def test_an_unknown_planner_is_refused(binary):
+    with ompl_native.Harness(binary) as native:
+        native.set_map(np.zeros((10, 10), np.uint8))
+        with pytest.raises(ompl_native.HarnessError, match="unknown planner"):
+            native.solve("PRMstar", (1.5, 1.5), (8.5, 8.5), bound=math.inf, limit=0.1)
