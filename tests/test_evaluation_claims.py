@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from vnrrt.data.instances import EvalInstance
-from vnrrt.evaluation import trials as trials_module
+from vnrrt.evaluation import sampling as sampling_module
 from vnrrt.evaluation.config import Configurations
 from vnrrt.evaluation.keys import ConfigKey
 from vnrrt.evaluation.paper_comparison.claims import (
@@ -99,13 +99,13 @@ def test_the_masked_control_runs_through_m_vnrrts_sampler(monkeypatch):
     vertex[2:6, 28:33] = 0.9  # above the wall's end: what a vertex network marks
     path = np.full((40, 60), 0.2, np.float32)  # a faint path network: nothing above 0.5
     calls = []
-    real = trials_module.make_sampler
+    real = sampling_module.make_sampler
 
-    def spy(planner, shape, heatmap, tau, mix):
-        calls.append((planner, round(float(np.asarray(heatmap).max()), 6), tau))
-        return real(planner, shape, heatmap, tau, mix)
+    def spy(planner, shape, heatmap, config):
+        calls.append((planner, round(float(np.asarray(heatmap).max()), 6), config.tau))
+        return real(planner, shape, heatmap, config)
 
-    monkeypatch.setattr(trials_module, "make_sampler", spy)
+    monkeypatch.setattr(sampling_module, "make_sampler", spy)
     inst = wall_instance({"vertexnet": vertex, "nrrtnet": path})
     keys = [ConfigKey("m_vnrrt_star", 0.5, "vertexnet"),
             ConfigKey("m_vnrrt_star", 0.5, "vertexnet").with_source("nrrtnet")]  # fmt: skip

@@ -9,7 +9,7 @@ import pytest
 
 from vnrrt.data.heatmaps import HeatmapError
 from vnrrt.data.instances import EvalInstance
-from vnrrt.evaluation import trials as trials_module
+from vnrrt.evaluation import sampling as sampling_module
 from vnrrt.evaluation.keys import ConfigKey
 from vnrrt.evaluation.protocol import trial_seed
 from vnrrt.evaluation.table import COLUMNS, CONVERGENCE_COLUMNS
@@ -133,6 +133,6 @@ def test_planning_time_excludes_building_the_sampler(monkeypatch):
     monkeypatch.setattr(planner_api, "make_sampler", slow(planner_api.make_sampler))
     r = plan(inst.grid, inst.start, inst.goal, "nrrt_star", heatmap=inst.heatmaps["path"])
     assert r.setup_time >= SLOW and r.time_to_stop < SLOW and r.success
-    monkeypatch.setattr(trials_module, "make_sampler", slow(trials_module.make_sampler))
+    monkeypatch.setattr(sampling_module, "make_sampler", slow(sampling_module.make_sampler))
     table = run_trials([inst], SPECS[1:2], {("named", "initial"): 3}, workers=1)
     assert (table["setup_time"] >= SLOW).all() and (table["time_to_stop"] < SLOW).all()

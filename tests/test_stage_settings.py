@@ -29,6 +29,7 @@ SETTINGS = {
     "ideas": ideas_settings,
     "validate": validate_config,
 }
+DICT_VALUES = ("sources", "families")  # keys whose values are dicts
 CHANGED = {  # key -> a valid value other than the default's
     "eval.planners": ["rrt_star", "vnrrt_star"],
     "eval.sources": {"nrrt_star": "vertexnet", "vnrrt_star": "nrrtnet", "m_vnrrt_star": "nrrtnet"},
@@ -43,21 +44,31 @@ CHANGED = {  # key -> a valid value other than the default's
     "eval.mask_variants": ["max"],
     "eval.masked_controls": False,
     "eval.endpoint_radius": 2.0,
+    "eval.zero_obstacles": True,
     "stats.bootstrap": 300,
     "stats.level": 0.9,
     "stats.tail_draws": 20,
     "stats.untestable_endpoint_share": 0.7,
     "stats.untestable_fallback": 0.6,
-    "oracle.kinds": ["oracle_path"],
-    "oracle.sigma": 2.5,
+    "oracle.families": {  # Hydra merges a dict override into the default: every key given
+        "path": ["oracle_path"],
+        "vertex": ["oracle_vertex"],
+        "control": ["oracle_endpoints"],
+    },
+    "oracle.sigmas": [2.5],
+    "oracle.mixes": [0.3],
+    "oracle.blend_weights": [0.0, 0.4],
+    "oracle.selection_share": 0.4,
     "oracle.floor": 0.1,
     "oracle.radius": 2.0,
     "oracle.qualities": [1.0, 0.3],
     "oracle.random_maps": 9,
-    "oracle.trials": 2,
+    "oracle.trials": 3,
     "oracle.parts": [0, 1],
     "regime.etas": [7.0],
     "regime.radius_modes": ["fixed2"],
+    "regime.gamma_factors": [0.5],
+    "regime.trials": 3,
     "regime.goal_radii": [3.0],
     "regime.configurations": ["rrt_star", "nrrt_star"],
     "regime.random_maps": 4,
@@ -76,7 +87,7 @@ def _flat(node, prefix: str = "") -> dict:
     """Dotted keys of a stage's settings (dataclasses and dicts nested)."""
     if dataclasses.is_dataclass(node):
         node = {f.name: getattr(node, f.name) for f in dataclasses.fields(node)}
-    if not isinstance(node, dict) or (prefix and prefix.rsplit(".", 1)[-1] == "sources"):
+    if not isinstance(node, dict) or (prefix and prefix.rsplit(".", 1)[-1] in DICT_VALUES):
         return {prefix: node}
     out = {}
     for k, v in node.items():

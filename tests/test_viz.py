@@ -174,21 +174,21 @@ def test_convergence_grid_names_ms_log_axes_with_labels_and_one_legend():
 def test_quality_curve_one_panel_per_stop_with_networks_as_stars():
     rows = []
     for stop in ("optimal", "optimal_any_angle"):
-        for idea, conf in (("oracle_path", "nrrt_star"), ("oracle_vertex", "vnrrt_star")):
-            for q, mass in ((1.0, 0.6), (0.1, 0.08), (0.0, 0.02)):
-                s = 1 + 10 * mass
-                rows.append((stop, idea, conf, q, mass, "iterations", s, s * 0.9, s * 1.1))
+        for idea, conf in (("path", "nrrt_star"), ("vertex", "vnrrt_star")):
+            for q, x in ((1.0, 30.0), (0.1, 4.0), (0.0, 1.0)):  # mass x a uniform map's
+                s = 1 + x / 3
+                rows.append((stop, idea, conf, q, x, "iterations", s, s * 0.9, s * 1.1))
     curves = pd.DataFrame(
         rows,
-        columns=["stop", "idea", "configuration", "q", "heat_mass", "metric", *SPEEDUP],
+        columns=["stop", "idea", "configuration", "q", "x_uniform", "metric", *SPEEDUP],
     )
     nets = pd.DataFrame(
         [
-            ("optimal", "vnrrt_star[vertexnet]", "iterations", 0.05, 1.3, 1.1, 1.5),
-            ("optimal", "m_vnrrt_star@0.5[vertexnet]", "iterations", 0.05, 1.31, 1.1, 1.5),
-            ("optimal", "vnrrt_star[vertexnet]+informed", "iterations", 0.05, 6.0, 5.0, 7.0),
+            ("optimal", "vnrrt_star[vertexnet]", "iterations", 2.5, 1.3, 1.1, 1.5),
+            ("optimal", "m_vnrrt_star@0.5[vertexnet]", "iterations", 2.5, 1.31, 1.1, 1.5),
+            ("optimal", "vnrrt_star[vertexnet]+informed", "iterations", 2.5, 6.0, 5.0, 7.0),
         ],
-        columns=["stop", "configuration", "metric", "heat_mass", *SPEEDUP],
+        columns=["stop", "configuration", "metric", "x_uniform", *SPEEDUP],
     )
     fig = quality_figure(curves, nets, {"eps": 0.02, "level": 0.8, "radius": 2.0})
     panels = fig.axes
@@ -198,16 +198,16 @@ def test_quality_curve_one_panel_per_stop_with_networks_as_stars():
     ]
     for ax in panels:
         assert ax.get_xscale() == ax.get_yscale() == "log"
-        assert "mass within 2 px" in ax.get_xlabel()
+        assert "mass within 2 px" in ax.get_xlabel() and "x a uniform map's" in ax.get_xlabel()
     assert "speed-up over RRT*" in panels[0].get_ylabel()
     (legend,) = fig.legends
     assert [t.get_text() for t in legend.get_texts()] == [
-        "NRRT*, path oracle",
-        "VNRRT*, vertex oracle",
+        "NRRT*, path envelope",
+        "VNRRT*, vertex envelope",
     ]
     stars = [line for line in panels[0].get_lines() if line.get_marker() == "*"]
     # the informed network is not placed on curves of plain samplers
-    assert [(s.get_xdata()[0], s.get_ydata()[0]) for s in stars] == [(0.05, 1.3), (0.05, 1.31)]
+    assert [(s.get_xdata()[0], s.get_ydata()[0]) for s in stars] == [(2.5, 1.3), (2.5, 1.31)]
     assert not [line for line in panels[1].get_lines() if line.get_marker() == "*"]
     labels = {t.get_text(): t for t in panels[0].texts}
     assert set(labels) == {"VNRRT* [vertexnet]", "M-VNRRT* τ=0.5 [vertexnet]"}

@@ -30,27 +30,33 @@ def free_rule(key: ConfigKey, default: bool) -> bool:
     return default != key.free
 
 
-def build_sampler(key: ConfigKey, heatmap: np.ndarray | None, allowed: np.ndarray,
-                  config: PlannerConfig, free: bool) -> tuple[Sampler, PlannerConfig]:  # fmt: skip
-    """The sampler of ``key`` on a map whose allowed cells are ``allowed`` ``(H, W)`` bool and
-    the settings ``plan`` must run it with; ``heatmap`` (already zero outside ``allowed``) is
-    the source's, None for RRT*; ``free``: :func:`free_rule`."""
+def build_sampler(
+    key: ConfigKey,
+    heatmap: np.ndarray | None,
+    allowed: np.ndarray,
+    config: PlannerConfig,
+    free: bool,
+) -> tuple[Sampler, PlannerConfig, bool]:
+    """``(sampler, settings, fallback)``: the sampler of ``key`` on a map whose allowed cells
+    are ``allowed`` ``(H, W)`` bool, the settings ``plan`` must run it with, and whether its
+    heatmap had no weight left (M-VNRRT*'s mask: it samples uniformly then); ``heatmap``
+    (already zero outside ``allowed``) is the source's, None for RRT*; ``free``:
+    :func:`free_rule`."""
     if key.mix is not None:
         config = config.replace(mix=float(key.mix))
     shape = allowed.shape
     if not free:
-        return make_sampler(key.planner, shape, heatmap, config), config
+        s = make_sampler(key.planner, shape, heatmap, config)
+        return s, config, s.fallback_uniform
     uniform = allowed / allowed.sum()
     if key.planner == "rrt_star":
         s = heatmap_sampler(uniform, shape, 1.0)
-        return dataclasses.replace(s, kind="uniform"), config
+        return dataclasses.replace(s, kind="uniform"), config, False
     masked = make_sampler(key.planner, shape, heatmap, config)
     weights = np.asarray(heatmap, np.float64)
     if key.tau is not None:
         weights = np.where(weights >= key.tau, weights, 0.0)
     total = weights.sum()
     mixture = uniform if total <= 0 else config.mix * weights / total + (1 - config.mix) * uniform
-    s = heatmap_sampler(mixture, shape, 1.0)
-    s = dataclasses.replace(s, kind=masked.kind, fallback_uniform=masked.fallback_uniform,
-                            tau=masked.tau)  # fmt: skip
-    return s, config.replace(mix=1.0)
+    s = dataclasses.replace(heatmap_sampler(mixture, shape, 1.0), kind=masked.kind, tau=masked.tau)
+    return s, config.replace(mix=1.0), masked.fallback_uniform

@@ -105,7 +105,7 @@ def run_job(
         heatmap = sources.mask_variant(heatmap, key.mask, inst, heat.endpoint_radius)
         measured = _measure(key, heatmap, allowed, inst, heat)
     tick = time.perf_counter()
-    sampler, config = build_sampler(key, heatmap, allowed, config, free)
+    sampler, config, fallback = build_sampler(key, heatmap, allowed, config, free)
     setup = time.perf_counter() - tick
     ref = inst.reference(stop)
     milestones = tuple(f * ref for f in CONVERGENCE_FACTORS) if stop != "initial" else ()
@@ -124,6 +124,7 @@ def run_job(
             milestones=milestones,
             config=config,
         )
+        r = dataclasses.replace(r, fallback_uniform=r.fallback_uniform or fallback)
         rows.append(_row(job, inst, trial, s, r, setup, ref, measured))
     return rows
 

@@ -101,7 +101,7 @@ def conclusion(summary: dict) -> list[str]:
             "above its family's envelope (the family is incomplete: a member "
             "this good was not among the oracles)",
             "below its family's envelope",
-            "no clearly different from its family's envelope",
+            "not clearly different from its family's envelope",
         )
         out.append(
             f"The trained {label(r['configuration'])} is {word}: {_x(s)} of the "
