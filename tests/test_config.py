@@ -72,11 +72,20 @@ def test_unknown_key_is_named():
         ("networks.vertexnet.target=corner", "networks.vertexnet.target"),
         ("stats.level=1.5", "stats.level"),
         ("seed=-3", "seed"),
+        # issue #28: combinations that cannot succeed or would be cut later, before any work
+        ("planner.eps=0", "planner.eps=0.*exact continuous optimum"),
+        ("eval.random_maps=0", "eval.random_maps=0.*random instances"),
+        ("oracle.random_maps=100000", "oracle.random_maps.*<= eval.random_maps"),
+        ("train.threads=0", "train.threads"),
     ],
 )
 def test_bad_values_fail_validation_naming_the_key(override, message):
     with pytest.raises(ConfigError, match=message):
         validate_config(compose([override]))
+
+
+def test_eps_zero_is_allowed_without_an_exact_stop():
+    validate_config(compose(["planner.eps=0", "eval.any_angle=false"]))
 
 
 def test_a_section_must_give_every_key():

@@ -35,7 +35,7 @@ def test_the_free_rule_draws_no_sample_on_obstacles_and_the_default_does(walled,
     for free in (False, True):
         allowed = allowed_cells(grid, free)
         h = None if planner == "rrt_star" else np.where(allowed, heat, 0.0)
-        sampler, used, _ = build_sampler(key, h, allowed, config, free)
+        sampler, _, _ = build_sampler(key, h, allowed, config, free)
         shares[free] = on_obstacles(grid, draw(sampler, 4000, seed=1))
     assert shares[True] == 0.0  # free cells only: heatmap and uniform part alike
     assert shares[False] > 0.2  # every cell: the wall (a quarter of the map) gets samples

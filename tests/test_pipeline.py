@@ -11,8 +11,10 @@ stage process created or changed (``writes.jsonl`` beside the work folder)."""
 import json
 import os
 import shutil
+import signal
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -40,12 +42,18 @@ def write_log(work: Path) -> Path:
     return work.parent / "writes.jsonl"
 
 
-def run(cmd: list[str], cwd: Path, ok: bool = True, **env_vars: str) -> str:
+def _env(cwd: Path, **env_vars: str) -> dict[str, str]:
+    """The environment of a DVC command in ``cwd``: this interpreter first on PATH, no MLflow
+    URI from outside, the write audit on."""
     env = dict(os.environ, PATH=f"{Path(sys.executable).parent}{os.pathsep}{os.environ['PATH']}")
     env.pop("MLFLOW_TRACKING_URI", None)
     env["PYTHONPATH"] = os.pathsep.join(p for p in (str(AUDIT), env.get("PYTHONPATH")) if p)
     env["VNRRT_WRITE_LOG"] = str(write_log(cwd))
-    env.update(env_vars)
+    return env | env_vars
+
+
+def run(cmd: list[str], cwd: Path, ok: bool = True, **env_vars: str) -> str:
+    env = _env(cwd, **env_vars)
     proc = subprocess.run(cmd, cwd=cwd, env=env, capture_output=True, text=True, check=False)
     if ok:
         assert proc.returncode == 0, f"{' '.join(cmd)} failed:\n{proc.stdout}\n{proc.stderr}"
@@ -398,3 +406,85 @@ def test_a_stage_runs_as_the_readme_says(workdir, repo):
         ["bash", "-c", cmd], cwd=workdir, env=env, capture_output=True, text=True, check=False
     )
     assert proc.returncode == 0, proc.stdout + proc.stderr
+
+
+def _back_to_the_commit(workdir: Path) -> None:
+    """The workspace as committed (after an experiment or a multirun test changed it)."""
+    run(["git", "checkout", "-q", "--", "."], workdir)
+    run(["dvc", "checkout", "-f", "-q"], workdir)
+
+
+def _experiment(shown: list, name: str) -> dict:
+    """The ``data`` of experiment ``name`` in ``dvc exp show --json``'s output."""
+    stack = list(shown)
+    while stack:
+        node = stack.pop()
+        if isinstance(node, dict):
+            if node.get("name") == name and isinstance(node.get("data"), dict):
+                return node["data"]
+            stack.extend(node.values())
+        elif isinstance(node, list):
+            stack.extend(node)
+    raise AssertionError(f"experiment {name} not in dvc exp show")
+
+
+@pytest.mark.slow
+def test_two_queued_experiments_finish_with_their_own_parameters(workdir):
+    """Issue #28: parallel ablations as the README says (`dvc exp run --queue` twice, then
+    `dvc queue start`): both finish, each with its own parameters in `dvc exp show` and in
+    the statistics it wrote."""
+    _back_to_the_commit(workdir)
+    levels = {"level-90": 0.9, "level-80": 0.8}
+    for name, level in levels.items():
+        sets = ["-S", "scale=smoke", "-S", "seed=1", "-S", f"stats.level={level}"]
+        run(["dvc", "exp", "run", "--queue", "-n", name, *sets], workdir)
+    run(["dvc", "queue", "start", "-j", "1"], workdir)
+    deadline = time.monotonic() + 1800
+    while True:
+        status = run(["dvc", "queue", "status"], workdir)
+        if not any(word in status.split() for word in ("Queued", "Running")):
+            break
+        assert time.monotonic() < deadline, status
+        time.sleep(5)
+    assert status.count("Success") == 2, status
+    proc = subprocess.run(["dvc", "exp", "show", "--json"], cwd=workdir, env=_env(workdir),
+                          capture_output=True, text=True, check=True)  # fmt: skip
+    shown = json.loads(proc.stdout)
+    for name, level in levels.items():
+        data = _experiment(shown, name)
+        assert data["params"]["params.yaml"]["data"]["stats"]["level"] == level
+        assert "headline.json" in json.dumps(data.get("metrics", {}))
+        run(["dvc", "exp", "apply", name], workdir)
+        summary = json.loads((workdir / "data/smoke/summary.json").read_text())
+        assert summary["level"] == level, name
+    _back_to_the_commit(workdir)
+
+
+@pytest.mark.slow
+def test_a_run_killed_after_its_trainings_does_not_train_again(workdir):
+    """Issue #28: a `dvc exp run` that retrains (another training seed) is killed (SIGKILL,
+    its whole process group) once its trainings have finished; the same command again
+    restores them and runs no training."""
+    _back_to_the_commit(workdir)
+    sets = ["dvc", "exp", "run", "-S", "scale=smoke", "-S", "seed=1", "-S", "train.seed=5"]
+    log = workdir.parent / "killed_run.log"
+    with log.open("w") as out:
+        proc = subprocess.Popen(sets, cwd=workdir, env=_env(workdir), stdout=out,
+                                stderr=subprocess.STDOUT, start_new_session=True)  # fmt: skip
+    deadline = time.monotonic() + 1800
+    try:
+        while "Running stage 'predict@" not in log.read_text():
+            assert proc.poll() is None and time.monotonic() < deadline, log.read_text()
+            time.sleep(0.2)
+    finally:
+        os.killpg(proc.pid, signal.SIGKILL)
+        proc.wait()
+    first = log.read_text()
+    assert sorted(ln for ln in first.splitlines() if "Running stage 'train@" in ln) == [
+        "Running stage 'train@nrrtnet':",
+        "Running stage 'train@vertexnet':",
+    ], first
+    again = run(sets, workdir)
+    assert "Running stage 'train@" not in again, again
+    assert "Running stage 'report'" in again
+    _back_to_the_commit(workdir)

@@ -1,13 +1,15 @@
 """Exit statuses of the DVC stage scripts: bad configuration or input is status 2 with one
 line on stderr, an internal error status 3 with its traceback; ``--help`` lists them."""
 
+import os
 import subprocess
 import sys
 
 import pytest
+import yaml
 
 from tests.conftest import copy_pipeline
-from vnrrt.config import compose, dump
+from vnrrt.config import ConfigError, check_unchanged_since_validate, compose, dump
 
 
 @pytest.fixture(scope="module")
@@ -84,3 +86,40 @@ def test_errors_are_classed_as_input_or_internal(capsys):
 
     assert run_reporting("prog", bad_input) == EXIT_INPUT
     assert capsys.readouterr().err == "prog: error: first line\n"
+
+
+def _lock_with_validate(path, params_doc):
+    """A dvc.lock whose validate entry recorded ``params_doc``'s seed, planner and eval."""
+    recorded = {k: params_doc[k] for k in ("seed", "planner", "eval")}
+    entry = {"cmd": "python stages/validate.py", "params": {"params.yaml": recorded}}
+    path.write_text(yaml.safe_dump({"schema": "2.0", "stages": {"validate": entry}}))
+
+
+def test_params_changed_since_validate_are_named(work, tmp_path):
+    """Issue #28: a second `dvc exp run` rewrote params.yaml after this run validated it."""
+    doc = yaml.safe_load((work / "params.yaml").read_text())
+    _lock_with_validate(tmp_path / "dvc.lock", doc)
+    params = tmp_path / "params.yaml"
+    params.write_text(yaml.safe_dump(dict(doc, workers=7)))  # not a validate parameter
+    check_unchanged_since_validate(params, tmp_path / "dvc.lock")
+    changed = dict(doc, planner=dict(doc["planner"], eps=0.05), seed=doc["seed"] + 1)
+    params.write_text(yaml.safe_dump(changed))
+    with pytest.raises(ConfigError, match=r"planner\.eps: 0\.01 -> 0\.05; seed: 0 -> 1\)"):
+        check_unchanged_since_validate(params, tmp_path / "dvc.lock")
+    check_unchanged_since_validate(params, tmp_path / "no.lock")  # a first run: no entry yet
+
+
+def test_a_stage_run_by_dvc_refuses_params_changed_since_validate(repo, work, tmp_path):
+    """The stage script (DVC_STAGE set, as DVC sets it) stops with status 2 and one line;
+    the same script run by hand (no DVC_STAGE) is not checked."""
+    dest = copy_pipeline(repo, tmp_path / "w")
+    doc = yaml.safe_load((work / "params.yaml").read_text())
+    _lock_with_validate(dest / "dvc.lock", doc)
+    doc["planner"]["eps"] = 0.05
+    (dest / "params.yaml").write_text(yaml.safe_dump(doc, sort_keys=False))
+    env = dict(os.environ, DVC_STAGE="named_maps")
+    out = subprocess.run([sys.executable, "stages/named_maps.py"], cwd=dest, env=env,
+                         capture_output=True, text=True, timeout=120)  # fmt: skip
+    assert out.returncode == 2 and "planner.eps: 0.01 -> 0.05" in out.stderr, out.stderr
+    assert "dvc exp run --queue" in out.stderr and out.stderr.count("\n") == 1
+    assert not (dest / "data").exists()  # nothing written

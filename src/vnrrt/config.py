@@ -149,6 +149,50 @@ def stage_params(stage: str, dvc_yaml: str | Path = "dvc.yaml") -> list[str]:
     return [k.replace("${item}", item) for k in keys]
 
 
+def _leaves(doc: Any, prefix: str = "") -> dict[str, Any]:
+    """``{dotted key: value}`` of the leaves of a nested mapping (lists are leaves)."""
+    if not isinstance(doc, Mapping):
+        return {prefix: doc}
+    out: dict[str, Any] = {}
+    for k, v in doc.items():
+        out.update(_leaves(v, f"{prefix}.{k}" if prefix else str(k)))
+    return out
+
+
+def check_unchanged_since_validate(params: str | Path, dvc_lock: str | Path) -> None:
+    """Refuse to go on when ``params`` no longer holds the values the ``validate`` stage of
+    this run recorded in ``dvc_lock`` (DVC writes a stage's entry as soon as it finishes).
+
+    That happens when a second ``dvc exp run -S ...`` in the same workspace rewrites
+    ``params.yaml`` while a first one is running: without this check the first run's later
+    stages would use the second run's values (issue #28). :class:`ConfigError` names every
+    changed key with both values. Nothing is checked when the lock or its ``validate``
+    entry is absent (a first run, a stage script run by hand)."""
+    import yaml
+
+    lock = Path(dvc_lock)
+    if not lock.is_file():
+        return
+    entry = ((yaml.safe_load(lock.read_text()) or {}).get("stages") or {}).get("validate")
+    recorded = ((entry or {}).get("params") or {}).get(Path(params).name)
+    if not recorded:
+        return
+    now = yaml.safe_load(Path(params).read_text()) or {}
+    before = _leaves(recorded)
+    after = _leaves({k: now.get(k) for k in recorded})
+    changed = [
+        f"{k}: {before.get(k)!r} -> {after.get(k)!r}"
+        for k in sorted(set(before) | set(after))
+        if before.get(k) != after.get(k)
+    ]
+    if changed:
+        raise ConfigError(
+            f"{params} changed since this run's validate stage ({'; '.join(changed)}): "
+            "another `dvc exp run` in this workspace? Queue parallel experiments instead "
+            "(`dvc exp run --queue -S ...`, then `dvc queue start`), or re-run `dvc repro`"
+        )
+
+
 def compose(overrides: list[str] | tuple[str, ...] = ()) -> DictConfig:
     """Compose ``conf/config.yaml`` with Hydra overrides and resolve it, exactly as DVC does."""
     from hydra import compose as hydra_compose

@@ -81,9 +81,16 @@ def stage_main(
     name = stage if not arg else f"{stage}@{getattr(args, arg)}"
 
     def run() -> int:
-        from vnrrt.config import load_params, restrict, stage_params
+        from vnrrt.config import (
+            check_unchanged_since_validate,
+            load_params,
+            restrict,
+            stage_params,
+        )
 
         params = Path(args.params)
+        if os.environ.get("DVC_STAGE") and stage != "validate":  # run by dvc repro / exp run
+            check_unchanged_since_validate(params, params.parent / "dvc.lock")
         cfg = load_params(params)
         dvc_yaml = Path("dvc.yaml") if Path("dvc.yaml").is_file() else params.parent / "dvc.yaml"
         view = restrict(cfg, stage_params(name, dvc_yaml))

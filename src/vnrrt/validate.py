@@ -62,6 +62,36 @@ def _random_maps(ev: EvalConfig, data: DataConfig, scale: ScaleConfig) -> None:
     )
 
 
+def _unreachable(cfg: DictConfig, typed: dict) -> None:
+    """Combinations that validate section by section but cannot succeed, or that a later
+    stage would cut without a word (issue #28)."""
+    planner, ev, oracle = typed["planner"], typed["eval"], typed["oracle"]
+    exact = ev.any_angle or planner.reference == "any_angle"
+    check(
+        not (exact and planner.eps == 0),
+        "planner.eps",
+        planner.eps,
+        "must be > 0 when a stop rule compares with the exact continuous optimum "
+        "(eval.any_angle=true or planner.reference=any_angle): a sampled path never "
+        "reaches it exactly, so every trial would run to its budget",
+    )
+    check(
+        ev.random_maps >= 1,
+        "eval.random_maps",
+        ev.random_maps,
+        "must be >= 1: the oracle, regime and ideas stages draw from the random instances",
+    )
+    check(
+        oracle.random_maps <= ev.random_maps,
+        "oracle.random_maps",
+        oracle.random_maps,
+        f"must be <= eval.random_maps ({ev.random_maps}): the oracle draws from those",
+    )
+    threads = cfg.get("train", {}).get("threads")
+    ok = threads is None or (isinstance(threads, int) and not isinstance(threads, bool))
+    check(ok and (threads is None or threads >= 1), "train.threads", threads, "null or >= 1")
+
+
 def validate_config(cfg: DictConfig) -> dict:
     """Check every section of a composed config; returns the typed sections."""
     if not isinstance(cfg, DictConfig) or not cfg:
@@ -88,6 +118,7 @@ def validate_config(cfg: DictConfig) -> dict:
             f"must name a network of `networks` ({sorted(networks)})",
         )
     _random_maps(typed["eval"], typed["data"], typed["scale"])
+    _unreachable(cfg, typed)
     for key in typed["regime"].configurations:
         spec = ConfigKey.parse(key, typed["eval"].sources)
         ok = spec.source is None or is_oracle(spec.source) or spec.source in networks

@@ -1,7 +1,7 @@
 """The MLflow run of the sampling-ideas study (stage ``ideas``): a parent run ``ideas
 <scale>`` (the oracle and regime settings as params, the report, figures and summary as
-artifacts) with one nested run per oracle-study configuration (success rate, median time in
-ms, speed-ups over RRT*, heatmap mass near its target)."""
+artifacts) with one nested run per configuration of the protocol's cell (success rate, median
+time in ms, speed-ups over RRT*, heatmap mass near its target, per stop rule)."""
 
 from __future__ import annotations
 
@@ -21,7 +21,7 @@ def log_ideas(
     mlflow.set_tracking_uri(uri)
     with mlflow.start_run(experiment_id=exp, run_name=f"ideas {scale}", tags=tags) as parent:
         mlflow.log_params(tracking.flat_params(params))
-        for key in sorted({k for per in summary["oracle"].values() for k in per}):
+        for key in sorted({r["configuration"] for r in _protocol(summary)}):
             with mlflow.start_run(
                 experiment_id=exp, run_name=key, nested=True, tags={**tags, "planner": key}
             ):
@@ -32,12 +32,20 @@ def log_ideas(
         return parent.info.run_id
 
 
+def _protocol(summary: dict) -> list[dict]:
+    """The summary's cell rows of the protocol's cell (the paper's planner settings)."""
+    from vnrrt.evaluation.sampling_ideas.design import PROTOCOL
+
+    return [r for r in summary["cells"] if r["regime"] == PROTOCOL]
+
+
 def oracle_metrics(summary: dict, key: str) -> dict[str, float]:
-    """Per stop rule, one oracle-study configuration's success rate, median time (ms),
-    heatmap mass near its target and speed-ups over RRT*."""
+    """Per stop rule, one configuration's success rate, median time (ms), heatmap mass near
+    its target and speed-ups over RRT* in the protocol's cell."""
     out = {}
-    for stop, per in summary["oracle"].items():
-        c = per.get(key, {})
+    for c in _protocol(summary):
+        if c["configuration"] != key:
+            continue
         vals = {
             "success_rate": c.get("success_rate"),
             "median_time_ms": c.get("median_ms"),
@@ -45,5 +53,6 @@ def oracle_metrics(summary: dict, key: str) -> dict[str, float]:
             "speedup_iterations": c.get("iterations", {}).get("speedup"),
             "speedup_time": c.get("time_to_stop", {}).get("speedup"),
         }
-        out.update(tracking.flat_metrics({stop: {k: v for k, v in vals.items() if v is not None}}))
+        values = {k: v for k, v in vals.items() if v is not None}
+        out.update(tracking.flat_metrics({c["stop"]: values}))
     return out
