@@ -262,3 +262,68 @@ def test_missing_repeated_or_foreign_parts_and_heatmaps_are_refused(cfg, repo, t
     swapped.paths.trials = str(tmp_path / "trials")
     with pytest.raises(ValueError, match="do not cover the instances"):
         run_trials_part(view(swapped, "trials@0", repo), 0)
+
+
+def _returned_folder(cfg, out: Path) -> Path:
+    """What a GPU run (scripts/gpu/paper_network.sh) returns for ``cfg``'s instances, with the
+    prediction parts' oracle heatmaps as the paper networks' heatmaps."""
+    from vnrrt.data.heatmaps import read_parts
+    from vnrrt.gpu.returned import NETWORKS, write_returned_heatmaps
+    from vnrrt.io import sha256
+
+    files = read_parts(cfg.paths.heatmaps, [0, 1])
+    maps = {paper: files["maps"][net] for paper, net in NETWORKS.items()}
+    kinds = dict(NETS)
+    meta = {paper: {"target": {"kind": kinds[net]}, "checkpoint_sha256": "a" * 64,
+                    "images_seen": 4096, "train_images_per_s": 900.0,
+                    "infer_images_per_s": 3000.0, "batch_size": 64}
+            for paper, net in NETWORKS.items()}  # fmt: skip
+    write_returned_heatmaps(out, files["keys"], maps, meta, machine="test", budget_s=60)
+    source = {"instances_sha256": sha256(cfg.paths.instances)}
+    train = {"steps": 64, "batch_size": 64, "train_images": 4096, "fit_seconds": 40.0}
+    networks = {p: {"target": m["target"], "train": train} for p, m in meta.items()}
+    doc = {"machine": "test", "budget_s": 60, "elapsed_s": 50, "phases": {}, "data": {},
+           "probe": {}, "networks": networks, "source": source}  # fmt: skip
+    (out / "metrics.json").write_text(json.dumps(doc))
+    return out
+
+
+def test_the_gpu_networks_are_heatmap_sources_of_the_trials(cfg, repo, tmp_path):
+    """Issue #27: with eval.gpu, a GPU run's returned heatmaps (read by the returned files'
+    reader) are sampled by NRRT*, VNRRT* and M-VNRRT* at planner.tau beside the trained
+    networks; the heatmap masses are those of the returned maps. A returned folder made for
+    other instances is refused, naming it."""
+    from vnrrt.gpu.returned import ReturnedError
+
+    gpu = copy.deepcopy(cfg)
+    gpu.eval.gpu = True
+    gpu.paths.gpu_returned = str(_returned_folder(cfg, tmp_path / "returned"))
+    gpu.paths.trials = str(tmp_path / "trials")
+    run_trials_part(view(gpu, "trials@0", repo), 0)
+    table = read_table(Path(gpu.paths.trials) / "part_0.csv")
+    tau = cfg.planner.tau
+    keys = {"nrrt_star[paper_nrrtnet]", "vnrrt_star[paper_vertexnet]",
+            f"m_vnrrt_star@{tau:g}[paper_vertexnet]"}  # fmt: skip
+    assert keys <= set(table["key"]), sorted(set(table["key"]))
+    per = table.groupby(["key", "instance"])["heat_mass"].first()
+    paper, net = per["nrrt_star[paper_nrrtnet]"], per["nrrt_star"]
+    both = paper.index.intersection(net.index)
+    assert len(both) > 0  # the same maps (both aim at the path): the same masses, per instance
+    np.testing.assert_allclose(paper[both], net[both], rtol=1e-6)
+    assert per["vnrrt_star[paper_vertexnet]"].notna().all()
+    from vnrrt.config import section
+    from vnrrt.evaluation.paper_comparison.disclosure import networks_scale_table
+    from vnrrt.evaluation.paper_comparison.stage import gpu_trainings
+    from vnrrt.paths import Paths
+
+    rows = gpu_trainings(section(gpu, "paths", Paths))  # the report's networks table
+    table = networks_scale_table(rows, "smoke", "ResNet34 U-Net")
+    assert "| paper_vertexnet (test, a 1-minute run) |" in table and "| 4,096 |" in table
+    (tmp_path / "other").mkdir()
+    other = _returned_folder(cfg, tmp_path / "other")
+    doc = json.loads((other / "metrics.json").read_text())
+    doc["source"]["instances_sha256"] = "b" * 64
+    (other / "metrics.json").write_text(json.dumps(doc))
+    gpu.paths.gpu_returned = str(other)
+    with pytest.raises(ReturnedError, match="another instances file"):
+        run_trials_part(view(gpu, "trials@0", repo), 0)

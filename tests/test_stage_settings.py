@@ -45,6 +45,7 @@ CHANGED = {  # key -> a valid value other than the default's
     "eval.masked_controls": False,
     "eval.endpoint_radius": 2.0,
     "eval.zero_obstacles": True,
+    "eval.gpu": True,
     "stats.bootstrap": 300,
     "stats.level": 0.9,
     "stats.tail_draws": 20,

@@ -45,6 +45,8 @@ class Paths:
     ideas_report: str
     paper_tables: str
     paper_settings: str
+    gpu_runs: str
+    gpu_returned: str
     named_maps_figure: str
     heatmaps_figure: str
     data_metrics: str

@@ -66,12 +66,14 @@ class EvalConfig(Configurations):
     random_initial: int = 1
     random_optimal: int = 1
     any_angle: bool = True  # also the optimal_any_angle stop rule (exact optimum)
+    gpu: bool = False  # also the GPU-trained paper networks (paths.gpu_returned) as sources
     parts: list[int] = field(default_factory=lambda: [0])  # trial parts: [0, 1, ..., K-1]
 
     def validate(self) -> None:
         """Raise :class:`ConfigError` naming the first invalid value."""
         super().validate()
         check_parts(self.parts, "eval.parts")
+        check(isinstance(self.gpu, bool), "eval.gpu", self.gpu, "true or false")
         for name in (
             "named_initial",
             "named_optimal",

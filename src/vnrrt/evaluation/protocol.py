@@ -40,7 +40,10 @@ def configurations(ev: Configurations, taus: list[float], tau: float) -> list[Co
     ``ev.informed`` each again with informed sampling (run on the random instances only);
     then, at the claims' threshold ``tau`` (``planner.tau``), M-VNRRT* with each mask variant
     of ``ev.mask_variants`` and, with ``ev.masked_controls``, on the path network's heatmap
-    (the masked NRRT* control, ``m_vnrrt_star@tau[<nrrt_star's source>]``)."""
+    (the masked NRRT* control, ``m_vnrrt_star@tau[<nrrt_star's source>]``); with ``ev.gpu``
+    (an :class:`EvalConfig`'s),
+    NRRT*, VNRRT* and M-VNRRT* at ``tau`` on the GPU-trained paper networks' heatmaps
+    (:data:`GPU_SOURCES`)."""
     keys = []
     for p in ev.planners:
         if p == "rrt_star":
@@ -56,7 +59,23 @@ def configurations(ev: Configurations, taus: list[float], tau: float) -> list[Co
         keys += [masked.with_mask(m) for m in ev.mask_variants]
         if ev.masked_controls:
             keys.append(masked.with_source(ev.sources["nrrt_star"]))
+    if isinstance(ev, EvalConfig) and ev.gpu:
+        keys += [k.with_source(GPU_SOURCES[k.planner]) for k in _gpu_planned(ev, tau)]
     return keys
+
+
+# planner -> the GPU-trained paper network it samples (vnrrt.gpu.returned.NETWORKS' names)
+GPU_SOURCES = {"nrrt_star": "paper_nrrtnet", "vnrrt_star": "paper_vertexnet",
+               "m_vnrrt_star": "paper_vertexnet"}  # fmt: skip
+
+
+def _gpu_planned(ev: Configurations, tau: float) -> list[ConfigKey]:
+    """The learned planners of ``ev.planners`` once each (M-VNRRT* at ``tau``)."""
+    return [
+        ConfigKey(p, float(tau) if p == "m_vnrrt_star" else None, ev.sources[p])
+        for p in ev.planners
+        if p in GPU_SOURCES
+    ]
 
 
 def trial_counts(ev: EvalConfig) -> dict[tuple[str, str], int]:

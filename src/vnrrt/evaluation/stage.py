@@ -59,12 +59,36 @@ def trials_settings(cfg: DictConfig) -> dict:
     }
 
 
+def add_gpu_heatmaps(instances: dict, paths: Paths) -> dict[str, str]:
+    """Add the GPU-trained paper networks' heatmaps (``paths.gpu_returned``, read and
+    checked against ``paths.instances`` by :func:`vnrrt.gpu.returned.read_returned`) to
+    ``instances`` ``{index: EvalInstance}`` in place; returns each network's target."""
+    import dataclasses
+
+    import numpy as np
+
+    from vnrrt.gpu.returned import NETWORKS, read_returned
+
+    got = read_returned(paths.gpu_returned, paths.instances)
+    for i, inst in instances.items():
+        heat = {n: m[i].astype(np.float32) for n, m in got["maps"].items()}
+        instances[i] = dataclasses.replace(inst, heatmaps={**inst.heatmaps, **heat})
+    kinds = {n: got["meta"][0]["networks"][n]["target"]["kind"] for n in NETWORKS}
+    return {n: "interior_vertices" if k == "vertex" else "path" for n, k in kinds.items()}
+
+
 def run_trials_part(cfg: DictConfig, part: int) -> int:
     """Stage ``trials@<part>``: the trials of part ``part`` of ``eval.parts`` ->
     ``paths.trials_part(part)``; returns the number of trials."""
     from vnrrt.data.instances import Instances, load
     from vnrrt.evaluation.config import mask_taus
-    from vnrrt.evaluation.protocol import configurations, part_jobs, trial_counts, trial_jobs
+    from vnrrt.evaluation.protocol import (
+        GPU_SOURCES,
+        configurations,
+        part_jobs,
+        trial_counts,
+        trial_jobs,
+    )
     from vnrrt.evaluation.table import write_table
     from vnrrt.evaluation.trials import HeatSettings, run_jobs
 
@@ -78,7 +102,10 @@ def run_trials_part(cfg: DictConfig, part: int) -> int:
     networks = sorted({k.source for k in keys if k.source is not None})
     indices = sorted({job.instance for job in jobs})
     parts = s["predict"]["parts"]
-    instances, targets = load(paths.instances, indices, networks, paths.heatmaps, parts)
+    trained = [n for n in networks if n not in GPU_SOURCES.values()]
+    instances, targets = load(paths.instances, indices, trained, paths.heatmaps, parts)
+    if len(trained) < len(networks):
+        targets |= add_gpu_heatmaps(instances, paths)
     log.info(
         "part %d/%d: %d trial jobs on %d instances", part, len(ev.parts), len(jobs), len(instances)
     )

@@ -50,8 +50,9 @@ def settings_table(settings: dict, values: dict) -> str:
 
 
 def networks_scale_table(trainings: dict[str, dict], scale: str, paper_network: str) -> str:
-    """The networks of this scale (``trainings``: network -> its training metrics file)
-    beside the paper's network."""
+    """The networks of this scale (``trainings``: network -> its training metrics file;
+    ``where`` in one, as for the GPU-trained networks, replaces ``scale``) beside the paper's
+    network."""
     lines = [
         "| network | architecture | parameters | initialisation | steps x batch | images seen | "
         "training wall time |",
@@ -69,7 +70,8 @@ def networks_scale_table(trainings: dict[str, dict], scale: str, paper_network: 
         batch = t.get("batch_size", "?")
         minutes = t.get("fit_seconds", math.nan) / 60
         lines.append(
-            f"| {name} ({scale}) | {arch} | {params} | {init} | {t.get('steps', '?')} x {batch} "
+            f"| {name} ({t.get('where', scale)}) | {arch} | {params} | {init} "
+            f"| {t.get('steps', '?')} x {batch} "
             f"| {t.get('train_images', 0):,} | {minutes:.0f} min |"
         )
     lines.append(f"| the paper's | {paper_network} | | | | | |")

@@ -125,6 +125,21 @@ def report_text(s: dict, summary: dict, predict: dict, trainings: dict, optima: 
     return build_report(inputs)
 
 
+def gpu_trainings(paths: Paths) -> dict[str, dict]:
+    """The GPU-trained paper networks' training records (``paths.gpu_returned``'s
+    ``metrics.json``, checked by :func:`vnrrt.gpu.returned.read_returned`) in the layout of
+    a training metrics file, ``where`` naming the machine and the budget."""
+    from vnrrt.gpu.returned import read_returned
+
+    run = read_returned(paths.gpu_returned, paths.instances)["metrics"]
+    where = f"{run['machine']}, a {run['budget_s'] / 60:.0f}-minute run"
+    out = {}
+    for name, n in run["networks"].items():
+        record = {"network": n.get("params", {}), "target": n.get("target", {})}
+        out[name] = {**record, **n.get("train", {}), "where": where}
+    return out
+
+
 def run_report(cfg: DictConfig) -> Path:
     """Stage ``report`` (module doc); returns the report's path."""
     from vnrrt import tracking
@@ -138,6 +153,8 @@ def run_report(cfg: DictConfig) -> Path:
         tracking.check_store(tracking.tracking_uri(logger.uri))
     summary, predict = read_json(paths.summary), read_json(paths.predict_metrics)
     trainings = {n: read_json(paths.train_metrics(n)) for n in predict["networks"]}
+    if ev.gpu:
+        trainings |= gpu_trainings(paths)
     optima = Instances(paths.instances).optima()
     write_text(paths.report, report_text(s, summary, predict, trainings, optima))
     figures = save_figures(paths, summary)
