@@ -40,12 +40,13 @@ repro: $(STAMP)  ## run the whole pipeline (dvc repro) at the default scale
 	$(BIN)/dvc repro
 
 CPU_REPORTS := reports/cpu
-repro-cpu: $(STAMP)  ## the CPU study scale (~80 min on 2 cores): both networks at train.seed 1, then the whole pipeline at seed 0; reports copied to reports/cpu/
+repro-cpu: $(STAMP)  ## the CPU study scale (~80 min on 2 cores): both networks at train.seed 1, then the whole pipeline at seed 0; reports copied to reports/cpu/, the per-trial tables behind them to reports/cpu/results/
 	$(BIN)/dvc exp run -S scale=cpu -S train.seed=1 predict_metrics
 	rm -rf $(CPU_REPORTS) && mkdir -p $(CPU_REPORTS)/seed1
 	cp reports/metrics/train_*.json reports/metrics/predict.json $(CPU_REPORTS)/seed1/
 	$(BIN)/dvc exp run -S scale=cpu
 	cp -r reports/paper_comparison.md reports/sampling_ideas.md reports/metrics reports/figures $(CPU_REPORTS)/
+	$(BIN)/python -m vnrrt.evaluation.recompute export --params params.yaml --out $(CPU_REPORTS)/results
 
 bench: $(STAMP)  ## run the benchmarks
 	for f in benchmarks/bench_*.py; do $(BIN)/python $$f || exit 1; done

@@ -148,10 +148,12 @@ def test_smoke_dvc_repro_end_to_end(workdir):
     ideas = (workdir / "reports/sampling_ideas.md").read_text()
     for text in (
         "## Conclusion",
-        "## Oracles, within 1% of A*",
+        "## Envelopes, within 1% of A*",
+        "The blend at each w against w = 0",
         "## The heatmap-quality curve",
+        "## The obstacle rule",
         "## The planner regime",
-        "VNRRT* [oracle_vertex]",
+        "[oracle_vertex@s",
     ):
         assert text in ideas, text
     assert (workdir / "reports/figures/ideas/quality_curve.png").stat().st_size > 10_000

@@ -31,7 +31,8 @@ BUNDLE = {  # file -> what it holds
     "regime.csv.gz": "the regime sweep's trials",
     "instances.json": "per map set the A*, exact and taut optimal lengths; the named maps",
     "predict.json": "the networks' heatmap metrics, inference times and their settings",
-    "train.json": "each network's training metrics (steps, images, time, architecture)",
+    "train.json": "each network's training metrics (steps, images, time, architecture; with "
+    "eval.gpu also the GPU-trained networks')",
 }
 
 
@@ -63,6 +64,10 @@ def export(params: Path, out: Path) -> list[Path]:
     predict = read_json(paths.predict_metrics)
     write_json(out / "predict.json", predict)
     trainings = {n: read_json(paths.train_metrics(n)) for n in predict["networks"]}
+    if cfg.eval.get("gpu"):  # the report's GPU-trained rows, as stage report reads them
+        from vnrrt.evaluation.paper_comparison.stage import gpu_trainings
+
+        trainings |= gpu_trainings(paths)
     write_json(out / "train.json", trainings)
     (out / "README.md").write_text(_schema())
     return [out / name for name in (*BUNDLE, "README.md")]
