@@ -464,11 +464,14 @@ def test_two_queued_experiments_finish_with_their_own_parameters(workdir):
 
 @pytest.mark.slow
 def test_a_run_killed_after_its_trainings_does_not_train_again(workdir):
-    """Issue #28: a `dvc exp run` that retrains (another training seed) is killed (SIGKILL,
-    its whole process group) once its trainings have finished; the same command again
-    restores them and runs no training."""
+    """Issue #28: a `dvc exp run --temp` (as queued experiments run: in a temporary copy,
+    lost when the run dies) that retrains (another training seed) is killed (SIGKILL, its
+    whole process group) once its trainings have finished; the same command again restores
+    them from DVC's run cache and runs no training. (In the workspace the finished stages'
+    lock entries survive a kill; in a temporary copy only the run cache does.)"""
     _back_to_the_commit(workdir)
-    sets = ["dvc", "exp", "run", "-S", "scale=smoke", "-S", "seed=1", "-S", "train.seed=5"]
+    sets = ["dvc", "exp", "run", "--temp", "-S", "scale=smoke", "-S", "seed=1",
+            "-S", "train.seed=5"]  # fmt: skip
     log = workdir.parent / "killed_run.log"
     with log.open("w") as out:
         proc = subprocess.Popen(sets, cwd=workdir, env=_env(workdir), stdout=out,
@@ -488,5 +491,6 @@ def test_a_run_killed_after_its_trainings_does_not_train_again(workdir):
     ], first
     again = run(sets, workdir)
     assert "Running stage 'train@" not in again, again
+    assert "Stage 'train@vertexnet' is cached - skipping run" in again
     assert "Running stage 'report'" in again
     _back_to_the_commit(workdir)
