@@ -1,6 +1,7 @@
 """The DVC pipeline end to end at smoke scale, in a scratch git + DVC copy of the repository:
 validation before any work, verified deterministic shards, resuming, temp files DVC does not
-hash, the whole run with its report, metrics, plots and MLflow runs, each stage writing
+hash, the whole run with its report, metrics, plots and MLflow runs (logged through a real
+tracking server and reviewed through its REST API; slow: in a browser), each stage writing
 exactly its outputs, reproducible outputs, an ablation experiment that re-runs only the
 evaluation and whose every report, figure and metrics file names the values it ran, and (slow)
 the parts as multirun jobs.
@@ -22,7 +23,9 @@ import pandas as pd
 import pytest
 import yaml
 
+from tests import mlflow_review as review
 from tests.conftest import copy_dvc_files, copy_pipeline
+from tests.mlflow_server import Rest, TrackingServer, metrics, params, tags
 from vnrrt.config import compose, dump, section
 from vnrrt.data.build import build_shard
 from vnrrt.data.config import LabelsConfig
@@ -71,6 +74,17 @@ def workdir(tmp_path_factory, repo):
     shutil.copy(repo / ".gitignore", work / ".gitignore")
     (work / "params.yaml").write_text(dump(compose(["scale=smoke"])))
     return work
+
+
+@pytest.fixture(scope="module")
+def tracking_server(workdir):
+    """A tracking server on the work folder's SQLite store, for the module; stopped after."""
+    server = TrackingServer(workdir / "mlflow.db", workdir.parent / "mlflow-server.log")
+    try:
+        server.wait()
+        yield server
+    finally:
+        server.stop()
 
 
 DATA_STAGES = ["manifest", "named_maps"]
@@ -126,11 +140,12 @@ def test_an_interrupted_run_resumes_after_the_last_finished_shard(workdir):
     assert not list((workdir / "data").rglob("*.tmp-*"))
 
 
-def test_smoke_dvc_repro_end_to_end(workdir):
-    """Every stage at smoke scale: report, headline metrics, plots and MLflow runs."""
+def test_smoke_dvc_repro_end_to_end(workdir, tracking_server):
+    """Every stage at smoke scale: report, headline metrics, plots and MLflow runs (the
+    stages log through the tracking server)."""
     from mlflow import MlflowClient
 
-    run(["dvc", "repro"], workdir)
+    run(["dvc", "repro"], workdir, MLFLOW_TRACKING_URI=tracking_server.url)
     report = (workdir / "reports/paper_comparison.md").read_text()
     for text in (
         "| VNRRT* | ours | ",
@@ -174,7 +189,110 @@ def test_smoke_dvc_repro_end_to_end(workdir):
     assert len(parents) == 1 and len(children) == 12 + 3
     train_ids = {r.info.run_id for r in runs if r.data.tags.get("kind") == "vertexnet"}
     assert parents[0].data.tags["training_run.vertexnet"] in train_ids
-    assert all(c.data.metrics["optimal/random/success_rate"] >= 0 for c in children)
+    rate = "random_maps/within_1pct_of_astar/success_rate"
+    assert all(0 <= c.data.metrics[rate] <= 1 for c in children)
+
+
+def test_the_study_reads_in_mlflow_through_the_rest_api(workdir, tracking_server):
+    """What a reviewer sees, read as the UI reads it (the server's REST API and artifact
+    route), against the pipeline's files: the evaluation run's description links, per-claim
+    metrics and verdict tags, model and dataset inputs (dvc.lock's hashes); the predict run's
+    figures and inference metric; the ideas children's params; the aliases (and a heatmap by
+    alias); the training runs' datasets and system metrics; every figure a logged report
+    shows among its run's artifacts."""
+    from vnrrt.data.instances import Instances
+    from vnrrt.predict import heatmap
+
+    rest = Rest(tracking_server.url)
+    exp = rest.get("experiments/get-by-name", experiment_name="vnrrt-smoke")["experiment"]
+    top, children = review.runs_by_kind(rest, exp["experiment_id"])
+    evaluation, ideas = top["evaluation"], top["ideas"]
+    review.check_description_links(rest, exp["experiment_id"], evaluation, workdir)
+    review.check_claims(evaluation, review.read(workdir, "data/smoke/summary.json"))
+    trainings = {n: review.read(workdir, f"reports/metrics/train_{n}.json") for n in
+                 ("vertexnet", "nrrtnet")}  # fmt: skip
+    models = {m["model_id"] for m in evaluation["inputs"]["model_inputs"]}
+    assert models == {t["mlflow_model_id"] for t in trainings.values()}
+    for model in models:
+        assert rest.get(f"logged-models/{model}")["model"]["info"]["name"] in trainings
+    heat = {f"heatmaps part_{k}": f"data/smoke/heatmaps/part_{k}.npz" for k in (0, 1)}
+    files = {"instances": "data/smoke/instances.npz", "trials": "data/smoke/trials.csv", **heat}
+    review.check_inputs(evaluation, workdir, "evaluation", files)
+    assert tags(evaluation)["ideas_run"] == ideas["info"]["run_id"]
+    assert review.check_reports(rest, evaluation) == ["paper_comparison.md"]
+    assert review.check_reports(rest, ideas) == ["sampling_ideas.md"]
+    predict = review.read(workdir, "reports/metrics/predict.json")
+    run = top["predict"]
+    assert "figures/heatmaps.png" in rest.artifact_paths(run["info"]["run_id"])
+    for net, m in predict["networks"].items():
+        assert metrics(run)[f"inference/ms_per_map/{net}"] == m["ms_per_map"]
+        assert metrics(run)[f"named_maps/interior_ap/{net}"] == m["named/interior_ap"]
+    review.check_ideas_children(children[ideas["info"]["run_id"]], review.read(
+        workdir, "data/smoke/ideas.json"))  # fmt: skip
+    names = {c["info"]["run_name"] for c in children[evaluation["info"]["run_id"]]}
+    assert all(n.endswith(" · evaluation smoke") for n in names) and len(names) == 15
+    for net, t in trainings.items():
+        alias = rest.get("registered-models/alias", name=f"vnrrt-{net}", alias="smoke")
+        assert alias["model_version"]["run_id"] == t["mlflow_run_id"]
+        train = rest.get("runs/get", run_id=t["mlflow_run_id"])["run"]
+        assert params(train)["network.target"] == t["target"]["kind"]
+        assert any(k.startswith("system/") for k in metrics(train))
+        split = {f"shards smoke ({s} split)": "data/smoke/manifest.json" for s in ("train",)}
+        review.check_inputs(train, workdir, "training", split)
+    inst = Instances(workdir / "data/smoke/instances.npz")[0]
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv("MLFLOW_TRACKING_URI", tracking_server.url)
+        by_alias = heatmap(
+            "models:/vnrrt-vertexnet@smoke", inst.grid, inst.start_cell, inst.goal_cell
+        )
+    by_file = heatmap(
+        workdir / "models/smoke/vertexnet.ckpt", inst.grid, inst.start_cell, inst.goal_cell
+    )
+    np.testing.assert_allclose(by_alias, by_file, atol=1e-6)
+
+
+@pytest.mark.slow
+def test_the_evaluation_run_page_shows_the_verdict_table_and_fig5_in_a_browser(
+    workdir, tracking_server
+):
+    """The evaluation run's page in headless Chromium: the verdict table (every claim and
+    its verdict) and Fig. 5 rendered (loaded, non-empty) in the description; the report's
+    HTML in the artifact viewer's frame. Needs Debian's chromium (``apt-get install
+    chromium`` as root)."""
+    from tests.browser import Browser, chromium, open_run_page
+
+    if chromium() is None:
+        pytest.skip("no chromium on PATH: `apt-get install chromium` (Debian, as root)")
+    run(["dvc", "repro"], workdir, MLFLOW_TRACKING_URI=tracking_server.url)  # up to date
+    rest = Rest(tracking_server.url)
+    exp = rest.get("experiments/get-by-name", experiment_name="vnrrt-smoke")["experiment"]
+    exp_id = exp["experiment_id"]
+    top, _ = review.runs_by_kind(rest, exp_id)
+    run_id = top["evaluation"]["info"]["run_id"]
+    rows = review.read(workdir, "data/smoke/summary.json")["claims"]["rows"]
+    with Browser() as page:
+        open_run_page(page, tracking_server.url, exp_id, run_id)
+        tables = page.wait_for(
+            "[...document.querySelectorAll('table')].map(t => t.innerText)"
+            ".filter(t => t.includes('verdict') && t.includes('the paper'))"
+        )
+        assert tables, "no verdict table on the run page"
+        lines = tables[0].splitlines()
+        for row in rows:
+            (line,) = [ln for ln in lines if ln.startswith(row["text"])]
+            assert row["verdict"] in line, (row["text"], line)
+        shown = page.wait_for(
+            "[...document.images].filter(i => i.src.includes('get-artifact') && i.complete"
+            " && i.naturalWidth > 0).map(i => [i.src, i.naturalWidth, i.naturalHeight])"
+        )
+        assert shown and "improvement_optimal.png" in shown[0][0] and shown[0][1] > 300
+        page.goto(f"{tracking_server.url}/#/experiments/{exp_id}/runs/{run_id}/artifacts/"
+                  "paper_comparison.html")  # fmt: skip
+        frame = page.wait_for(
+            "[...document.querySelectorAll('iframe')].map(f => f.src).filter(s => "
+            "s.startsWith('blob:'))"
+        )
+        assert frame, "the HTML report is not shown in the artifact viewer"
 
 
 def test_metrics_and_plots_read_well(workdir):
@@ -331,6 +449,16 @@ def test_an_ablation_reruns_only_the_evaluation_and_every_output_names_its_value
     headline = json.loads((workdir / "reports/metrics/headline.json").read_text())
     variants = {"m0.6_max", "m0.6_noends", "m0.6_nrrtnet"}  # at the claims' tau, planner.tau
     assert set(headline["opt_ms"]) == {"rrt", "nrrt", "vnrrt", "m0.3", "m0.6", "m0.7", *variants}
+    from mlflow import MlflowClient  # the experiment's evaluation run names its values too
+
+    client = MlflowClient(f"sqlite:///{workdir / 'mlflow.db'}")
+    exp = client.get_experiment_by_name("vnrrt-smoke").experiment_id
+    newest = ["attributes.start_time DESC"]
+    query = "tags.mlflow.runName = 'evaluation smoke'"
+    (last,) = client.search_runs([exp], query, order_by=newest, max_results=1)
+    names = "\n".join(last.data.metrics)
+    assert "within_5pct_of_astar/median_ms/m_vnrrt_star_tau0.6" in names
+    assert "within_1pct" not in names
 
 
 PAPER_REPORTS = ("reports/paper_comparison.md", "reports/sampling_ideas.md")

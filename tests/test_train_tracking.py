@@ -81,14 +81,15 @@ def test_git_commit_is_read_from_the_git_files(tmp_path):
     assert tracking.git_commit(tmp_path / "nothing") == "unknown"
 
 
-def test_params_are_flat_scalars():
-    flat = tracking.flat_params({"a": {"b": [1, 2], "c": None, "d": {"e": 0.5}}})
-    assert flat == {"a.b": "1,2", "a.c": "null", "a.d.e": 0.5}
+def test_params_are_flat_text_with_one_spelling_of_booleans_and_nulls():
+    flat = tracking.flat_params({"a": {"b": [1, True], "c": None, "d": {"e": 0.5, "f": False}}})
+    assert flat == {"a.b": "1,true", "a.c": "null", "a.d.e": "0.5", "a.d.f": "false"}
 
 
 def test_a_training_run_is_recorded_in_mlflow(small_data, tmp_path, monkeypatch):
     import mlflow.pytorch
 
+    from vnrrt.lineage import file_md5
     from vnrrt.predict import heatmap
 
     monkeypatch.setenv("DVC_STAGE", "train@vertexnet")
@@ -112,22 +113,51 @@ def test_a_training_run_is_recorded_in_mlflow(small_data, tmp_path, monkeypatch)
     assert tags["checkpoint_sha256"] == metrics["checkpoint_sha256"]
     assert tags["git_commit"] == tracking.git_commit(Path(__file__).resolve().parents[1])
     params = run.data.params
-    assert params["model.net.encoder"] == "resnet18" and params["network.kind"] == "vertex"
+    assert params["model.net.encoder"] == "resnet18" and params["network.target"] == "vertex"
     assert params["train.datamodule.batch_size"] == str(cfg.train.datamodule.batch_size)
-    # what determines the weights, not infrastructure or settings of other stages
-    assert not [k for k in params if k.startswith(("paths.", "logger.", "planner.", "eval."))]
-    assert params["net_info.encoder_frozen"] == "False" and params["net_info.weights"] == "none"
+    assert params["trainer.deterministic"] == "true" and params["model.net.weights"] == "null"
+    assert not {v for v in params.values() if v in ("True", "False", "None", "none")}
+    # what determines the weights: not infrastructure, not settings of other stages
+    infrastructure = ("paths.", "logger.", "planner.", "eval.", "callbacks.", "net_info.")
+    assert not [k for k in params if k.startswith(infrastructure) or k.endswith("_partial_")]
+    assert "train.datamodule.shards_dir" not in params and "trainer.default_root_dir" not in params
+    assert run.data.metrics["network/params_total"] == metrics["network"]["params_total"]
     assert len(client.get_metric_history(run.info.run_id, "val/loss")) == 2  # per epoch
     assert "test/vertex_recall" in run.data.metrics and "train/loss_epoch" in run.data.metrics
-    listed = {
-        a.path for folder in ("", "figures") for a in client.list_artifacts(run.info.run_id, folder)
+    assert any(k.startswith("system/cpu") for k in run.data.metrics)  # system metrics
+    # the shards as one dataset per split, the manifest's DVC hash as digest
+    inputs = {
+        i.dataset.name: (i.dataset.digest, {t.key: t.value for t in i.tags}["mlflow.data.context"])
+        for i in run.inputs.dataset_inputs
     }
-    assert {"config.yaml", "figures/val_epoch_000.png", "figures/val_epoch_001.png"} <= listed
+    digest = file_md5(small_data / "manifest.json")
+    assert inputs == {
+        "shards smoke (train split)": (digest, "training"),
+        "shards smoke (val split)": (digest, "validation"),
+        "shards smoke (test split)": (digest, "test"),
+    }
+    # the validation figure as an MLflow image per epoch (the UI's step slider)
+    images = {a.path for a in client.list_artifacts(run.info.run_id, "images")}
+    assert len(images) == 2 * 2 and all("val_predictions" in p for p in images)  # png + json
+    assert {"config.yaml"} <= {a.path for a in client.list_artifacts(run.info.run_id)}
     assert run.info.artifact_uri.startswith((tmp_path / "mlartifacts").as_uri())
-    # The network as an MLflow Model: loadable by URI, registered, same heatmap as the checkpoint.
+    # The network as an MLflow Model named after it, with its test metrics; registered with a
+    # description, tags and the scale's alias; loadable by URI, same heatmap as the checkpoint.
+    model_info = client.get_logged_model(metrics["mlflow_model_id"])
+    assert model_info.name == "vertexnet" and model_info.source_run_id == run.info.run_id
+    logged = {m.key: m.value for m in model_info.metrics}
+    assert logged["test/vertex_recall"] == pytest.approx(metrics["test/vertex_recall"])
+    assert metrics["mlflow_model_version"] == "models:/vnrrt-vertexnet/1"
+    version = client.get_model_version_by_alias("vnrrt-vertexnet", "smoke")
+    assert str(version.version) == "1" and version.run_id == run.info.run_id
+    assert "scale `smoke`" in version.description and "test/vertex_recall" in version.description
+    assert version.tags["target"] == "vertex" and version.tags["training_run"] == run.info.run_id
+    assert version.tags["checkpoint_sha256"] == metrics["checkpoint_sha256"]
+    assert client.get_registered_model("vnrrt-vertexnet").description.startswith("vertexnet: a")
+    note = tags["mlflow.note.content"]  # the run's description links its version
+    assert "[vnrrt-vertexnet/1](#/models/vnrrt-vertexnet/versions/1)" in note and "@smoke" in note
     mlflow.set_tracking_uri(f"sqlite:///{tmp_path}/mlflow.db")
-    model = mlflow.pytorch.load_model(f"runs:/{run.info.run_id}/model")
-    assert client.get_registered_model("vnrrt-vertexnet").name == "vnrrt-vertexnet"
+    model = mlflow.pytorch.load_model(f"runs:/{run.info.run_id}/vertexnet")
     from vnrrt.data.reader import Shard
 
     shard = Shard(small_data / "shards" / "shard_0.npz")
@@ -141,7 +171,9 @@ def test_a_training_run_is_recorded_in_mlflow(small_data, tmp_path, monkeypatch)
     np.testing.assert_allclose(from_mlflow, from_ckpt, atol=1e-6)
     # ... and by URI through vnrrt.predict, with the rendering the network was trained with
     monkeypatch.setenv("MLFLOW_TRACKING_URI", f"sqlite:///{tmp_path}/mlflow.db")
-    for uri in (f"runs:/{run.info.run_id}/model", "models:/vnrrt-vertexnet/1"):
+    uris = (f"runs:/{run.info.run_id}/vertexnet", "models:/vnrrt-vertexnet/1",
+            "models:/vnrrt-vertexnet@smoke")  # fmt: skip
+    for uri in uris:
         loaded = load_model(uri)
         assert loaded.render == load_network(tmp_path / "models" / "vertexnet.ckpt")[1]["render"]
         assert loaded.record["target"]["kind"] == "vertex"  # logged: checked for a planner

@@ -83,10 +83,15 @@ def read_json(path: str | Path) -> Any:
         raise ValueError(f"{path} is not valid JSON: {err}") from None
 
 
-def sha256(path: str | Path) -> str:
-    """Hex sha256 of a file's bytes."""
-    h = hashlib.sha256()
+def file_digest(path: str | Path, algorithm: str = "sha256") -> str:
+    """Hex digest of a file's bytes (``algorithm``: a ``hashlib`` name)."""
+    h = hashlib.new(algorithm)
     with open(path, "rb") as f:
         for block in iter(lambda: f.read(1 << 20), b""):
             h.update(block)
     return h.hexdigest()
+
+
+def sha256(path: str | Path) -> str:
+    """Hex sha256 of a file's bytes."""
+    return file_digest(path, "sha256")

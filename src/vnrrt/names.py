@@ -39,6 +39,20 @@ def stop_title(stop: str, eps: float) -> str:
     return f"cost <= {1 + eps:g} x exact continuous optimum (stricter; ours, eps {eps:g})"
 
 
+def stop_slug(stop: str, eps: float) -> str:
+    """A stop rule as a part of an MLflow metric name: ``initial_solution``,
+    ``within_1pct_of_astar``, ``within_0.5pct_of_exact_optimum``."""
+    if stop == "initial":
+        return "initial_solution"
+    reference = "astar" if stop == "optimal" else "exact_optimum"
+    return f"within_{percent(eps).replace('%', 'pct')}_of_{reference}"
+
+
+def map_set_slug(map_set: str) -> str:
+    """A map set as a part of an MLflow metric name: ``random_maps``, ``map_3``."""
+    return "random_maps" if map_set == "random" else map_set
+
+
 def level_name(level: float) -> str:
     """A confidence level as text: ``0.95`` -> ``95%``."""
     return f"{100 * level:g}%"

@@ -11,8 +11,11 @@ evaluation runs.
   repository was copied or moved), :func:`experiment_id` points the experiment at this
   repository's ``mlartifacts`` again, so a copy never writes into the original.
 * **Experiments**: one per scale (``logger.experiment``, ``vnrrt-<scale>`` by default);
-  runs named ``<network> <scale>`` and ``evaluation <scale>``, tagged with kind, scale, git
-  commit, DVC stage and experiment.
+  runs named ``<network> <scale>``, ``predict <scale>``, ``ideas <scale>`` and ``evaluation
+  <scale>``, tagged with kind, scale, git commit, DVC stage and experiment; params spelled
+  as in YAML (:func:`param_text`). What each run holds: ``vnrrt.training.runs``,
+  ``vnrrt.predict.runs``, ``vnrrt.evaluation.*.runs``; lineage between them:
+  :mod:`vnrrt.lineage`.
 * **Telemetry** is off (``MLFLOW_DISABLE_TELEMETRY=true`` unless set otherwise before vnrrt
   is imported): stages make no network calls. ``MLFLOW_DISABLE_TELEMETRY=false`` turns it on.
 * **Services**: a tracking server (``http(s)://``) or database (``postgresql://`` ...) is
@@ -39,7 +42,6 @@ import time
 import urllib.error
 import urllib.request
 from pathlib import Path
-from typing import Any
 from urllib.parse import urlsplit
 
 os.environ.setdefault("MLFLOW_DISABLE_TELEMETRY", "true")
@@ -205,21 +207,29 @@ def run_tags(kind: str, scale: str, **extra: str) -> dict[str, str]:
     }
 
 
-def flat_params(cfg, prefix: str = "") -> dict[str, Any]:
-    """A (nested) config flattened to ``{"a.b.c": value}`` with scalar values: lists become
-    comma-separated text, ``None`` the text ``null``; for MLflow params."""
+def param_text(value) -> str:
+    """A scalar as an MLflow param: booleans and ``None`` spelled as in YAML (``true``,
+    ``false``, ``null``), everything else as ``str``."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    return "null" if value is None else str(value)
+
+
+def flat_params(cfg, prefix: str = "") -> dict[str, str]:
+    """A (nested) config flattened to ``{"a.b.c": text}`` for MLflow params: scalars as
+    :func:`param_text`, lists as comma-separated text."""
     from omegaconf import DictConfig, OmegaConf
 
     node = OmegaConf.to_container(cfg, resolve=True) if isinstance(cfg, DictConfig) else cfg
-    out: dict[str, Any] = {}
+    out: dict[str, str] = {}
     for key, value in node.items():
         name = f"{prefix}{key}"
         if isinstance(value, dict):
             out.update(flat_params(value, name + "."))
         elif isinstance(value, list | tuple):
-            out[name] = ",".join(str(v) for v in value)
+            out[name] = ",".join(param_text(v) for v in value)
         else:
-            out[name] = "null" if value is None else value
+            out[name] = param_text(value)
     return out
 
 
@@ -278,13 +288,20 @@ class LoggerConfig:
     artifact_location: str | None
     log_model: bool
     registry_prefix: str | None
+    system_metrics_seconds: float | None
     lightning: dict
 
     def validate(self) -> None:
-        if not self.experiment:
-            from vnrrt.config import ConfigError
+        from vnrrt.config import ConfigError
 
+        if not self.experiment:
             raise ConfigError("invalid config value logger.experiment: an empty name")
+        seconds = self.system_metrics_seconds
+        if seconds is not None and not seconds > 0:
+            raise ConfigError(
+                f"invalid config value logger.system_metrics_seconds={seconds!r}: a positive "
+                "number of seconds, or null for no system metrics"
+            )
 
 
 def metric_name(*parts: str) -> str:

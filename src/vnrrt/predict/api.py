@@ -1,7 +1,8 @@
 """One heatmap from a trained network for one (grid, start, goal), in one call.
 
 A network comes from a vnrrt checkpoint (``models/<scale>/vertexnet.ckpt``), from an MLflow
-model URI (``runs:/<run id>/model``, ``models:/vnrrt-vertexnet/1``) or is given as a loaded
+model URI (``runs:/<run id>/vertexnet``, ``models:/vnrrt-vertexnet/1``, by the alias of the scale
+that trained it: ``models:/vnrrt-vertexnet@quick``) or is given as a loaded
 :class:`~vnrrt.predict.api.Model`. The input image is rendered exactly as in training (the
 checkpoint's record: start/goal marker radius, normalisation). ``target`` asks for a network
 trained on one target (``vnrrt.data.targets.PLANNER_TARGETS``: the one each planner samples);

@@ -5,7 +5,7 @@
   ``predict.threads``; the inference time goes to ``paths.timing_part(k)``);
 * ``predict_metrics``: the heatmap metrics over the named maps and the random instances with
   their settings, the inference time per map (``paths.predict_metrics``) and Fig. 3
-  (``paths.heatmaps_figure``).
+  (``paths.heatmaps_figure``); the MLflow run ``predict <scale>`` (:mod:`vnrrt.predict.runs`).
 """
 
 from __future__ import annotations
@@ -99,9 +99,13 @@ def run_predict_metrics(cfg: DictConfig) -> dict:
     from vnrrt.data.instances import Instances
     from vnrrt.io import read_json, write_json
     from vnrrt.predict.batch import heatmap_metrics
+    from vnrrt.tracking import LoggerConfig, check_store, tracking_uri
     from vnrrt.viz.evaluation import save_heatmaps
 
     paths = section(cfg, "paths", Paths)
+    logger = section(cfg, "logger", LoggerConfig)
+    if logger.enabled:  # an unreachable store fails here, before any work
+        check_store(tracking_uri(logger.uri))
     parts = check_parts(cfg.predict.parts, "predict.parts")
     instances = Instances(paths.instances)
     files = read_parts(paths.heatmaps, parts)
@@ -147,4 +151,11 @@ def run_predict_metrics(cfg: DictConfig) -> dict:
         {n: m[named] for n, m in files["maps"].items()},
         titles=[f"Map {k + 1}: {i.map.replace('_', ' ')}" for k, i in enumerate(shown)],
     )
+    if logger.enabled:
+        from vnrrt.predict.runs import log_predict
+
+        files = {"predict.json": paths.predict_metrics, "figure": paths.heatmaps_figure,
+                 "instances": paths.instances}  # fmt: skip
+        trainings = {n: paths.train_metrics(n) for n in results}
+        log_predict(logger, str(cfg.scale.name), out, files, trainings, shown)
     return out

@@ -4,8 +4,8 @@
   log``, CI) no bar but one :class:`LogProgress` line every ``every_n_steps`` steps and one
   per validation.
 * :class:`PredictionFigures`: after each validation epoch, input, ground truth and predicted
-  heatmap of the first validation instances (the paper's Fig. 3) as an MLflow artifact
-  ``figures/val_epoch_<epoch>.png``.
+  heatmap of the first validation instances (the paper's Fig. 3) as an MLflow image
+  ``val_predictions`` at the epoch's step (the run page's image grid has a step slider).
 """
 
 from __future__ import annotations
@@ -19,6 +19,7 @@ from lightning.pytorch.callbacks import Callback, TQDMProgressBar
 from lightning.pytorch.loggers import MLFlowLogger
 
 log = logging.getLogger(__name__)
+IMAGE_KEY = "val_predictions"  # the MLflow image of PredictionFigures
 
 
 class LogProgress(Callback):
@@ -79,15 +80,15 @@ class PredictionFigures(Callback):
         if self._kept is None or not loggers:
             return
         from vnrrt.maps.render import colorize
-        from vnrrt.viz.common import close
+        from vnrrt.viz.common import close, rgb_image
         from vnrrt.viz.training import prediction_figure
 
         k = self._kept
         titles = [f"shard {s}, instance {i}" for s, i in k["key"]]
         fig = prediction_figure(colorize(k["classes"]), k["target"], k["vertices"], k["probs"],
                                 titles)  # fmt: skip
-        name = f"figures/val_epoch_{trainer.current_epoch:03d}.png"
-        for lg in loggers:
-            lg.experiment.log_figure(lg.run_id, fig, name)
+        image = rgb_image(fig)
         close(fig)
+        for lg in loggers:
+            lg.experiment.log_image(lg.run_id, image, key=IMAGE_KEY, step=trainer.current_epoch)
         self._kept = None

@@ -5,9 +5,9 @@ LightningModule factories from ``train``, the callbacks from ``callbacks``, the
 :func:`vnrrt.training.train.fit`.
 
 Outputs: ``paths.checkpoint(network)`` (with the record of :func:`make_record`) and its
-sidecar ``.sha256``, ``paths.train_metrics(network)`` and an MLflow run holding the network as
-an MLflow Model (pytorch flavour, signature, input example), registered as
-``vnrrt-<network>``.
+sidecar ``.sha256``, ``paths.train_metrics(network)`` and an MLflow run
+(:mod:`vnrrt.training.runs`) holding the network as an MLflow Model (pytorch flavour,
+signature, input example), registered as ``vnrrt-<network>`` with the alias ``@<scale>``.
 
 **Resuming**: Lightning writes ``paths.run_folder(network) / "last.ckpt"`` after every
 epoch. A re-run after a kill resumes from it when it was written with the same settings (its
@@ -140,26 +140,6 @@ def build_callbacks(callbacks: DictConfig | None, folder: Path, with_logger: boo
     return out
 
 
-def make_logger(logger_cfg: tracking.LoggerConfig, scale: str, network: str, record: dict,
-                settings: dict, config_text: str):  # fmt: skip
-    """The run's ``MLFlowLogger``: experiment per scale, tags, the flattened ``settings`` and
-    the network's target under common keys (``network.target``, ``network.endpoints``) as
-    params, the run's whole config (``config_text``) as ``config.yaml``."""
-    from hydra.utils import instantiate
-
-    uri, _, tags = tracking.open_experiment(
-        logger_cfg, network, scale, fingerprint=record["fingerprint"]
-    )
-    logger = instantiate(
-        logger_cfg.lightning, run_name=f"{network} {scale}", tracking_uri=uri, tags=tags
-    )
-    target = {k: record["target"][k] for k in ("kind", "endpoints", "radius")}
-    logger.log_hyperparams(tracking.flat_params({**settings, "network": target}))
-    logger.log_hyperparams({f"net_info.{k}": v for k, v in record["describe"].items()})
-    logger.experiment.log_text(logger.run_id, config_text, "config.yaml")
-    return logger
-
-
 def one_handler() -> None:
     """Let Lightning's log lines reach the root handler once (Lightning installs handlers of
     its own on import, and its lines were printed twice under the stages' logging setup)."""
@@ -180,6 +160,21 @@ def fix_threads(threads: int | None) -> int:
             raise ValueError(f"train.threads must be >= 1 or null, got {threads!r}")
         torch.set_num_threads(int(threads))
     return torch.get_num_threads()
+
+
+def monitored_fit(logger_cfg: tracking.LoggerConfig, logger, fit_run):
+    """``fit_run()`` with the system metrics of ``logger``'s run monitored (None: not)."""
+    if logger is None:
+        return fit_run()
+    from vnrrt.training.runs import SystemMetrics
+
+    monitor = SystemMetrics(
+        logger.run_id, tracking.tracking_uri(logger_cfg.uri), logger_cfg.system_metrics_seconds
+    )
+    try:
+        return fit_run()
+    finally:
+        monitor.stop()
 
 
 def run_train(cfg: DictConfig, network: str) -> dict:
@@ -212,10 +207,11 @@ def run_train(cfg: DictConfig, network: str) -> dict:
     resume = resume_from(spec, paths, network, record)
     if resume is not None:
         check_checkpoint(resume, record, module)
-    logger = None
+    logger, scale = None, str(cfg.scale.name)
     if logger_cfg.enabled:
-        scale, text = str(cfg.scale.name), OmegaConf.to_yaml(cfg)
-        logger = make_logger(logger_cfg, scale, network, record, settings, text)
+        from vnrrt.training.runs import start_run
+
+        logger = start_run(logger_cfg, scale, network, record, settings, OmegaConf.to_yaml(cfg))
     callbacks = build_callbacks(cfg.get("callbacks"), paths.run_folder(network), logger is not None)
     bar = any(type(c).__name__ == "TQDMProgressBar" for c in callbacks)
     precision = resolve_precision(cfg.trainer.precision, cfg.trainer.accelerator)
@@ -229,11 +225,12 @@ def run_train(cfg: DictConfig, network: str) -> dict:
     )
     out, metrics_file = paths.checkpoint(network), paths.train_metrics(network)
     batch = int(cfg.train.datamodule.batch_size)
-    metrics = fit(module, datamodule, trainer, out, metrics_file, batch, resume)
+    metrics = monitored_fit(logger_cfg, logger if trainer.is_global_zero else None,
+                            lambda: fit(module, datamodule, trainer, out, metrics_file, batch,
+                                        resume))  # fmt: skip
     if trainer.is_global_zero:
         if logger is not None:
-            metrics["mlflow_run_id"] = logger.run_id
-            log_model(logger_cfg, network, out, logger, datamodule)
+            metrics |= finish_run(logger_cfg, scale, network, out, logger, datamodule, metrics)
         from vnrrt.io import write_json
         from vnrrt.model.checkpoint import write_checksum
 
@@ -247,33 +244,18 @@ def run_train(cfg: DictConfig, network: str) -> dict:
     return metrics
 
 
-def log_model(logger_cfg: tracking.LoggerConfig, network: str, checkpoint: Path, logger,
-              datamodule) -> None:  # fmt: skip
-    """Log the trained network to the run as an MLflow Model (pytorch flavour) with a
-    signature and an input example, and register it as ``<registry_prefix><network>``."""
+def finish_run(logger_cfg: tracking.LoggerConfig, scale: str, network: str, checkpoint: Path,
+               logger, datamodule, metrics: dict) -> dict:  # fmt: skip
+    """Tag the run with the checkpoint's hash and, with ``logger.log_model``, log and register
+    the network (:func:`vnrrt.training.runs.log_model`); returns what the training metrics
+    file records of the run."""
     from vnrrt.io import sha256
+    from vnrrt.training.runs import log_model
 
     logger.experiment.set_tag(logger.run_id, "checkpoint_sha256", sha256(checkpoint))
-    if not logger_cfg.log_model:
-        return
-    import mlflow
-    import mlflow.pytorch
-
-    from vnrrt.model.checkpoint import load_network
-
-    net, record = load_network(checkpoint, network)
-    example = datamodule.datasets["val"][0]["image"][None].numpy()  # (1, 3, S, S) float32
-    mlflow.set_tracking_uri(tracking.tracking_uri(logger_cfg.uri))
-    with mlflow.start_run(run_id=logger.run_id):
-        prefix = logger_cfg.registry_prefix
-        registered = prefix + network if prefix else None
-        # pickle: load_model returns the nn.Module itself (any batch size; needs vnrrt installed)
-        mlflow.pytorch.log_model(
-            net,
-            name="model",
-            input_example=example,
-            registered_model_name=registered,
-            serialization_format="pickle",
-            # how to draw its input image, and what it predicts (checked by vnrrt.predict)
-            metadata={"render": dict(record["render"]), "target": dict(record["target"])},
-        )
+    out = {"mlflow_run_id": logger.run_id}
+    if logger_cfg.log_model:
+        example = datamodule.datasets["val"][0]["image"][None].numpy()  # (1, 3, S, S) float32
+        tested = {k: v for k, v in metrics.items() if k.startswith("test/")}
+        out |= log_model(logger_cfg, scale, network, checkpoint, logger, example, tested)
+    return out

@@ -40,6 +40,13 @@ def save_figure(fig, out_png: str | Path, dpi: int = 110) -> None:
     plt.close(fig)
 
 
+def rgb_image(fig, dpi: int = 90) -> np.ndarray:
+    """``fig`` drawn as an (H, W, 3) uint8 RGB array (for MLflow's step images)."""
+    fig.set_dpi(dpi)
+    fig.canvas.draw()
+    return np.asarray(fig.canvas.buffer_rgba())[..., :3].copy()
+
+
 def close(fig) -> None:
     """Release a figure made here (after logging it elsewhere, e.g. to MLflow)."""
     plt.close(fig)

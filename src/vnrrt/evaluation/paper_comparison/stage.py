@@ -5,7 +5,8 @@
   convergence curves (``paths.convergence``, ``paths.convergence_plots``);
 * ``report``: ``paths.report`` (:func:`.report.build_report`), Fig. 5 and the convergence
   figure (``paths.evaluation_figures``), the headline metrics (``paths.headline``) and the
-  MLflow evaluation runs (:mod:`.runs`).
+  MLflow evaluation runs (:mod:`.runs`; they link the ideas run of ``paths.ideas_summary``
+  and log the heatmap parts of ``paths.heatmaps`` as datasets).
 """
 
 from __future__ import annotations
@@ -161,14 +162,15 @@ def run_report(cfg: DictConfig) -> Path:
     metrics = headline(summary, predict["networks"])
     write_json(paths.headline, metrics)
     if logger.enabled:
-        from vnrrt.evaluation.paper_comparison.runs import log_evaluation
+        from vnrrt.evaluation.paper_comparison.runs import EvaluationFiles, log_evaluation
 
-        artifacts = [Path(paths.report), *figures, Path(paths.trials_table)]
-        trainings = {n: paths.train_metrics(n) for n in sorted(set(ev.sources.values()))}
+        files = EvaluationFiles(
+            Path(paths.report), figures, Path(paths.trials_table), Path(paths.instances),
+            sorted(Path(paths.heatmaps).glob("part_*.npz")), Path(paths.predict_metrics),
+            Path(paths.ideas_summary), {n: Path(paths.train_metrics(n)) for n in trainings},
+        )  # fmt: skip
         params = {"eval": dataclasses.asdict(ev), "planner": dataclasses.asdict(planner)}
-        log_evaluation(
-            logger, scale["name"], params, ev.sources, summary, metrics, artifacts, trainings
-        )
+        log_evaluation(logger, scale["name"], params, ev.sources, summary, metrics, files)
     return Path(paths.report)
 
 

@@ -1,0 +1,186 @@
+"""The MLflow run of a training (stage ``train@<network>``), named ``<network> <scale>``.
+
+* **Params**: what determines the weights, flattened (``seed``, ``model.*``, ``train.*``,
+  ``trainer.*``) and the network's target under keys common to every network
+  (``network.target``, ``network.endpoints``, ``network.target_radius``), so that comparing
+  two trainings shows their difference; infrastructure (:data:`INFRASTRUCTURE`: file places,
+  loader workers, callbacks, Hydra's ``_partial_``) is left out: the run's whole config is
+  its ``config.yaml`` artifact. The network's parameter counts are metrics
+  (``network/params_total``).
+* **Inputs**: the shards as one dataset per split (``training``, ``validation``, ``test``),
+  each with the DVC hash of the manifest that lists every shard's checksum as its digest.
+* **System metrics** (``system/*``: CPU, memory, disk, network, GPU where there is one) every
+  ``logger.system_metrics_seconds``, and a last sample when training ends.
+* **The model**: the network as an MLflow Model named after it (``runs:/<run id>/<network>``)
+  with its test metrics, registered as ``<registry_prefix><network>`` with a description,
+  tags (scale, target, run, checkpoint hash, commit) and the alias ``@<scale>``
+  (``models:/vnrrt-vertexnet@quick``): the version that scale trained last.
+"""
+
+from __future__ import annotations
+
+import logging
+from pathlib import Path
+
+from vnrrt import tracking
+
+log = logging.getLogger(__name__)
+# flattened config keys (prefixes) that say where and how a run works, not what it learns
+INFRASTRUCTURE = ("callbacks.", "train.datamodule.shards_dir", "train.datamodule.manifest",
+                  "train.datamodule.num_workers", "train.datamodule.pin_memory",
+                  "trainer.default_root_dir", "trainer.log_every_n_steps")  # fmt: skip
+SPLITS = {"train": "training", "val": "validation", "test": "test"}  # split -> input context
+
+
+def run_params(settings: dict, record: dict) -> dict:
+    """The training's params (module doc) from its ``settings`` (seed, model, train, trainer,
+    callbacks as plain containers) and checkpoint ``record``."""
+    t = record["target"]
+    network = {"target": t["kind"], "endpoints": t["endpoints"], "target_radius": t["radius"]}
+    flat = tracking.flat_params({**settings, "network": network})
+    return {
+        k: v
+        for k, v in flat.items()
+        if not k.startswith(INFRASTRUCTURE) and not k.endswith("._partial_")
+    }
+
+
+def start_run(logger_cfg: tracking.LoggerConfig, scale: str, network: str, record: dict,
+              settings: dict, config_text: str):  # fmt: skip
+    """The run's ``MLFlowLogger`` (experiment per scale, tags, :func:`run_params`, the
+    parameter counts and ``config.yaml``) with the shard datasets logged as inputs."""
+    from hydra.utils import instantiate
+
+    uri, _, tags = tracking.open_experiment(
+        logger_cfg, network, scale, fingerprint=record["fingerprint"]
+    )
+    logger = instantiate(
+        logger_cfg.lightning, run_name=f"{network} {scale}", tracking_uri=uri, tags=tags
+    )
+    logger.log_hyperparams(run_params(settings, record))
+    counts = {k: v for k, v in record["describe"].items() if k.startswith("params_")}
+    logger.log_metrics({f"network/{k}": float(v) for k, v in counts.items()})
+    logger.experiment.log_text(logger.run_id, config_text, "config.yaml")
+    log_shards(logger.experiment, logger.run_id, scale, settings["train"]["datamodule"])
+    return logger
+
+
+def log_shards(client, run_id: str, scale: str, datamodule: dict) -> None:
+    """The shards as one input dataset per split (module doc; ``datamodule``: the
+    ``train.datamodule`` settings)."""
+    from vnrrt import lineage
+
+    manifest = Path(datamodule["manifest"])
+    for split, context in SPLITS.items():
+        name = f"shards {scale} ({split} split)"
+        lineage.log_datasets(client, run_id, {name: manifest}, context)
+
+
+class SystemMetrics:
+    """MLflow's system-metrics monitor of run ``run_id`` sampling every ``seconds`` (None: no
+    monitoring); :meth:`stop` logs a last sample, so that a short run has one too."""
+
+    def __init__(self, run_id: str, uri: str, seconds: float | None) -> None:
+        self.monitor = None
+        if seconds is None:
+            return
+        from mlflow.system_metrics.system_metrics_monitor import SystemMetricsMonitor
+
+        self.monitor = SystemMetricsMonitor(run_id, sampling_interval=float(seconds),
+                                            tracking_uri=uri)  # fmt: skip
+        self.monitor.start()
+
+    def stop(self) -> None:
+        if self.monitor is None:
+            return
+        m, self.monitor = self.monitor, None
+        m.finish()
+        m.collect_metrics()
+        m.publish_metrics(m.aggregate_metrics())
+        m.mlflow_logger.flush()
+
+
+def log_model(logger_cfg: tracking.LoggerConfig, scale: str, network: str, checkpoint: Path,
+              logger, example, tested: dict) -> dict:  # fmt: skip
+    """Log the trained network to the run (module doc; ``example``: one input image,
+    ``tested``: its test metrics) and register it; returns what the training metrics file
+    records of it: ``mlflow_model_id`` and ``mlflow_model_version`` (``models:/<name>/<v>``,
+    when registered)."""
+    import mlflow
+    import mlflow.pytorch
+
+    from vnrrt.io import sha256
+    from vnrrt.model.checkpoint import load_network
+
+    net, record = load_network(checkpoint, network)
+    mlflow.set_tracking_uri(tracking.tracking_uri(logger_cfg.uri))
+    prefix = logger_cfg.registry_prefix
+    with mlflow.start_run(run_id=logger.run_id):
+        # pickle: load_model returns the nn.Module itself (any batch size; needs vnrrt installed)
+        info = mlflow.pytorch.log_model(
+            net,
+            name=network,
+            input_example=example,
+            registered_model_name=prefix + network if prefix else None,
+            serialization_format="pickle",
+            # how to draw its input image, and what it predicts (checked by vnrrt.predict)
+            metadata={"render": dict(record["render"]), "target": dict(record["target"])},
+            tags={"scale": scale, "target": record["target"]["kind"]},
+        )
+        mlflow.log_metrics(tested, model_id=info.model_id)
+    out = {"mlflow_model_id": info.model_id}
+    if info.registered_model_version is not None:
+        name, version = prefix + network, str(info.registered_model_version)
+        describe_version(logger.experiment, name, version, scale, record, logger.run_id, tested,
+                         sha256(checkpoint))  # fmt: skip
+        out["mlflow_model_version"] = f"models:/{name}/{version}"
+    note = describe_run(network, scale, record, tested, out.get("mlflow_model_version"))
+    logger.experiment.set_tag(logger.run_id, "mlflow.note.content", note)
+    return out
+
+
+def describe_run(network: str, scale: str, record: dict, tested: dict,
+                 version: str | None) -> str:  # fmt: skip
+    """The training run's markdown description: the network, its target, its test metrics
+    and its registry version."""
+    from vnrrt.lineage import model_version_link
+
+    t = record["target"]
+    lines = [
+        f"**`{network}` trained at scale `{scale}`**: a {t['kind']} heatmap network (endpoints "
+        f"{t['endpoints']}, target radius {t['radius']:g} px). Test metrics: "
+        + ", ".join(f"`{k}` {v:.4g}" for k, v in sorted(tested.items())) + ".",
+    ]  # fmt: skip
+    if version:
+        shown = version.removeprefix("models:/")
+        lines += ["", f"Registered as [{shown}]({model_version_link(version)}), alias "
+                  f"`@{scale}`: `vnrrt.predict.heatmap(\"{version.rsplit('/', 1)[0]}@{scale}\", "
+                  "grid, start, goal)`."]  # fmt: skip
+    return "\n".join(lines) + "\n"
+
+
+def describe_version(client, name: str, version: str, scale: str, record: dict, run_id: str,
+                     tested: dict, checkpoint_sha: str) -> None:  # fmt: skip
+    """A registry version's description, tags and alias ``<scale>`` (module doc)."""
+    target = record["target"]
+    client.update_registered_model(
+        name, description=f"{record['network']}: a {target['kind']} heatmap network of the "
+        "vnrrt study (a (3, S, S) map image in, per-pixel probabilities out)."
+    )  # fmt: skip
+    shown = ", ".join(f"{k} {v:.4g}" for k, v in sorted(tested.items()))
+    client.update_model_version(
+        name, version, description=f"Trained at scale `{scale}` by run {run_id} "
+        f"(target: {target['kind']}, endpoints {target['endpoints']}). Test: {shown}."
+    )  # fmt: skip
+    tags = {
+        "scale": scale,
+        "target": target["kind"],
+        "endpoints": target["endpoints"],
+        "training_run": run_id,
+        "checkpoint_sha256": checkpoint_sha,
+        "fingerprint": record["fingerprint"],
+        "git_commit": tracking.git_commit(),
+    }
+    for key, value in tags.items():
+        client.set_model_version_tag(name, version, key, value)
+    client.set_registered_model_alias(name, scale, version)
