@@ -34,6 +34,9 @@ from vnrrt.maps.config import DataConfig
 from vnrrt.paths import Paths, stage_outputs
 
 SHARDS = Path("data/smoke/shards")
+# The smoke scale with one training budget (conf/budget: none at smoke by default), of the
+# pipeline training's own 3 steps: the budget stages run, and must reproduce that training.
+SMOKE = ["scale=smoke", "budget.steps=[3]", "budget.report=[training_budget]"]
 AUDIT = Path(__file__).resolve().parent / "write_audit"
 
 
@@ -69,7 +72,7 @@ def workdir(tmp_path_factory, repo):
     run(["dvc", "init", "-q"], work)
     copy_dvc_files(repo, work)
     shutil.copy(repo / ".gitignore", work / ".gitignore")
-    (work / "params.yaml").write_text(dump(compose(["scale=smoke"])))
+    (work / "params.yaml").write_text(dump(compose(SMOKE)))
     return work
 
 
@@ -119,7 +122,7 @@ def test_a_stray_temp_file_beside_the_shards_changes_nothing(workdir):
 def test_an_interrupted_run_resumes_after_the_last_finished_shard(workdir):
     """DVC records each finished stage in dvc.lock; a run stopped after shard@0 resumes
     with shard@1 and does not redo shard@0."""
-    (workdir / "params.yaml").write_text(dump(compose(["scale=smoke", "seed=1"])))
+    (workdir / "params.yaml").write_text(dump(compose([*SMOKE, "seed=1"])))
     run(["dvc", "repro", "shard@0"], workdir)  # the run that got this far, then stopped
     out = run(["dvc", "repro", *DATA_STAGES], workdir)
     assert "Running stage 'shard@1'" in out and "Running stage 'shard@0'" not in out
@@ -177,6 +180,40 @@ def test_smoke_dvc_repro_end_to_end(workdir):
     assert all(c.data.metrics["optimal/random/success_rate"] >= 0 for c in children)
 
 
+def test_the_budget_stages_reproduce_the_training_of_their_steps(workdir):
+    """The smoke budget of 3 steps has the pipeline training's settings: the same checkpoint
+    bytes; its heatmap metrics are predict_metrics' on them (up to the float16 heatmaps of
+    another batching); its report; one MLflow run per budget training, with the budget as a
+    param, and no model registered beside the pipeline's networks."""
+    from mlflow import MlflowClient
+
+    metrics, budget = workdir / "reports/metrics", workdir / "data/smoke/budget/3"
+    predict = json.loads((metrics / "predict.json").read_text())["networks"]
+    again = json.loads((budget / "predict.json").read_text())["networks"]
+    sha = {}
+    for name in ("vertexnet", "nrrtnet"):
+        main = json.loads((metrics / f"train_{name}.json").read_text())
+        run = json.loads((budget / f"train_{name}.json").read_text())
+        assert run["checkpoint_sha256"] == main["checkpoint_sha256"], name
+        assert run["budget"]["schedule_steps"] == run["budget"]["schedule_total"] == 3
+        sha[name] = run["checkpoint_sha256"]
+        numbers = [k for k, v in predict[name].items() if k != "ms_per_map" and v != str(v)]
+        want = {k: predict[name][k] for k in numbers}
+        assert {k: again[name][k] for k in numbers} == pytest.approx(want, rel=1e-3, abs=1e-5)
+        assert again[name]["target"] == predict[name]["target"]
+    report = (workdir / "reports/training_budget.md").read_text()
+    assert "## What the curve says" in report and "one budget: no trend" in report
+    client = MlflowClient(f"sqlite:///{workdir / 'mlflow.db'}")
+    exp = client.get_experiment_by_name("vnrrt-smoke").experiment_id
+    runs = client.search_runs([exp], filter_string="tags.budget_steps = '3'")
+    stages = sorted(r.data.tags["dvc_stage"] for r in runs)
+    assert stages == ["budget_train@nrrtnet-3", "budget_train@vertexnet-3"]
+    for r in runs:
+        assert r.data.params["budget.steps"] == "3" and r.info.run_name.endswith(" budget 3")
+        assert r.data.tags["checkpoint_sha256"] == sha[r.data.tags["kind"]]
+    assert len(client.search_model_versions("name='vnrrt-vertexnet'")) == 1
+
+
 def test_metrics_and_plots_read_well(workdir):
     """`dvc metrics show` stays short; each convergence plot has one series per planner and
     renders to PNG offline."""
@@ -199,9 +236,11 @@ NOT_OUTPUTS = ("mlflow.db", "mlartifacts/")  # the MLflow store: runs, not pipel
 
 
 def _stage_of(argv: list[str]) -> tuple[str, str | None]:
-    """``(stage, item)`` of a stage script's command line: ``stages/trials.py --part 1``."""
+    """``(stage, item)`` of a stage script's command line: ``stages/trials.py --part 1``,
+    ``stages/budget_train.py --network vertexnet --steps 3`` (item ``vertexnet-3``)."""
     name = Path(argv[0]).stem
-    return name, (argv[2] if len(argv) > 2 and argv[1].startswith("--") else None)
+    values = argv[2::2] if len(argv) > 2 and argv[1].startswith("--") else []
+    return name, ("-".join(values) if values else None)
 
 
 def test_every_stage_writes_exactly_its_outputs(workdir, repo):

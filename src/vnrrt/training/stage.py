@@ -1,17 +1,19 @@
-"""Entry point of the ``train@<network>`` stages: build every object from config with
-``hydra.utils.instantiate`` (the network and loss from ``model``, the DataModule and the
-LightningModule factories from ``train``, the callbacks from ``callbacks``, the
+"""Entry points of the ``train@<network>`` stages and of the budget curve's
+``budget_train@<network>-<steps>`` (:mod:`vnrrt.training.budget`): build every object from
+config with ``hydra.utils.instantiate`` (the network and loss from ``model``, the DataModule
+and the LightningModule factories from ``train``, the callbacks from ``callbacks``, the
 ``lightning.Trainer`` from ``trainer``; as lightning-hydra-template does), then call
 :func:`vnrrt.training.train.fit`.
 
-Outputs: ``paths.checkpoint(network)`` (with the record of :func:`make_record`) and its
-sidecar ``.sha256``, ``paths.train_metrics(network)`` and an MLflow run holding the network as
-an MLflow Model (pytorch flavour, signature, input example), registered as
-``vnrrt-<network>``.
+Outputs (:class:`vnrrt.paths.TrainFiles`: ``paths.training(network)``, or
+``paths.budget_training(network, steps)``): the checkpoint (with the record of
+:func:`make_record`) and its sidecar ``.sha256``, the metrics JSON and an MLflow run
+(:mod:`vnrrt.training.runs`); a pipeline training's run holds the network as an MLflow Model
+(pytorch flavour, signature, input example), registered as ``vnrrt-<network>``.
 
-**Resuming**: Lightning writes ``paths.run_folder(network) / "last.ckpt"`` after every
-epoch. A re-run after a kill resumes from it when it was written with the same settings (its
-record's ``fingerprint``), and says why it restarts otherwise; the folder is removed after a
+**Resuming**: Lightning writes ``<run folder>/last.ckpt`` after every epoch. A re-run after a
+kill resumes from it when it was written with the same settings (its record's
+``fingerprint``), and says why it restarts otherwise; the folder is removed after a
 successful run. Resuming gives the same weights as an uninterrupted run (tested).
 """
 
@@ -28,7 +30,7 @@ from omegaconf import DictConfig, OmegaConf
 
 from vnrrt import tracking
 from vnrrt.config import ConfigError, section
-from vnrrt.paths import Paths
+from vnrrt.paths import Paths, TrainFiles
 
 log = logging.getLogger(__name__)
 LOGGER_CALLBACKS = ("learning_rate_monitor", "prediction_figures")  # need an MLflow logger
@@ -103,15 +105,14 @@ def make_record(network: str, net_config: dict, spec: NetworkSpec, dm: dict, net
     }
 
 
-def resume_from(spec: NetworkSpec, paths: Paths, network: str, record: dict) -> Path | None:
-    """The checkpoint to resume from: ``spec.resume`` if set, else the last checkpoint of an
-    interrupted run with the same settings (module doc), else None."""
+def resume_from(spec: NetworkSpec, last: Path, network: str, record: dict) -> Path | None:
+    """The checkpoint to resume from: ``spec.resume`` if set, else ``last`` (the last
+    checkpoint of an interrupted run) when it has the same settings (module doc), else None."""
     from vnrrt.model.checkpoint import CheckpointError, read_checkpoint
     from vnrrt.model.module import RECORD_KEY
 
     if spec.resume is not None:
         return Path(spec.resume)
-    last = paths.run_folder(network) / "last.ckpt"
     if not last.is_file():
         return None
     try:
@@ -140,26 +141,6 @@ def build_callbacks(callbacks: DictConfig | None, folder: Path, with_logger: boo
     return out
 
 
-def make_logger(logger_cfg: tracking.LoggerConfig, scale: str, network: str, record: dict,
-                settings: dict, config_text: str):  # fmt: skip
-    """The run's ``MLFlowLogger``: experiment per scale, tags, the flattened ``settings`` and
-    the network's target under common keys (``network.target``, ``network.endpoints``) as
-    params, the run's whole config (``config_text``) as ``config.yaml``."""
-    from hydra.utils import instantiate
-
-    uri, _, tags = tracking.open_experiment(
-        logger_cfg, network, scale, fingerprint=record["fingerprint"]
-    )
-    logger = instantiate(
-        logger_cfg.lightning, run_name=f"{network} {scale}", tracking_uri=uri, tags=tags
-    )
-    target = {k: record["target"][k] for k in ("kind", "endpoints", "radius")}
-    logger.log_hyperparams(tracking.flat_params({**settings, "network": target}))
-    logger.log_hyperparams({f"net_info.{k}": v for k, v in record["describe"].items()})
-    logger.experiment.log_text(logger.run_id, config_text, "config.yaml")
-    return logger
-
-
 def one_handler() -> None:
     """Let Lightning's log lines reach the root handler once (Lightning installs handlers of
     its own on import, and its lines were printed twice under the stages' logging setup)."""
@@ -184,7 +165,26 @@ def fix_threads(threads: int | None) -> int:
 
 def run_train(cfg: DictConfig, network: str) -> dict:
     """Stage ``train@<network>``: train ``network`` as configured (module doc); returns and
-    writes its metrics. The stage's parameters are read here; below, typed pieces."""
+    writes its metrics."""
+    return train_network(cfg, network, section(cfg, "paths", Paths).training(network))
+
+
+def run_budget_train(cfg: DictConfig, network: str, steps: int) -> dict:
+    """Stage ``budget_train@<network>-<steps>``: ``network`` trained for ``steps`` optimizer
+    steps with a schedule of its own (:func:`vnrrt.training.budget.budget_config`) ->
+    ``paths.budget_training(network, steps)``, resumable as the pipeline's trainings; its
+    metrics add ``budget`` (:func:`budget_record`)."""
+    from vnrrt.training.budget import budget_config
+
+    files = section(cfg, "paths", Paths).budget_training(network, steps)
+    return train_network(budget_config(cfg, steps), network, files, budget=int(steps))
+
+
+def train_network(cfg: DictConfig, network: str, files: TrainFiles,
+                  budget: int | None = None) -> dict:  # fmt: skip
+    """Train ``network`` as ``cfg`` says into ``files`` (module doc); ``budget``: the steps
+    of a budget-curve training (its MLflow run, no MLflow Model). The stage's parameters are
+    read here; below, typed pieces."""
     logger_cfg = section(cfg, "logger", tracking.LoggerConfig)
     uri = tracking.configure(logger_cfg.uri)  # before Lightning (and its MLflow logger) imports
     if logger_cfg.enabled:
@@ -195,6 +195,7 @@ def run_train(cfg: DictConfig, network: str) -> dict:
     one_handler()
 
     from vnrrt.model.checkpoint import check_checkpoint
+    from vnrrt.training.runs import log_model, make_logger
     from vnrrt.training.train import fit, resolve_precision
 
     paths, spec = section(cfg, "paths", Paths), network_spec(cfg, network)
@@ -207,73 +208,53 @@ def run_train(cfg: DictConfig, network: str) -> dict:
     net, loss = instantiate(cfg.model.net), instantiate(cfg.model.loss)
     record = make_record(network, settings["model"]["net"], spec, settings["train"]["datamodule"],
                          net, fingerprint(settings, spec, paths))  # fmt: skip
-    make_module = instantiate(cfg.train.module, _partial_=True)
-    module = make_module(net=net, loss=loss, record=record)
-    resume = resume_from(spec, paths, network, record)
+    module = instantiate(cfg.train.module, _partial_=True)(net=net, loss=loss, record=record)
+    resume = resume_from(spec, files.run_folder / "last.ckpt", network, record)
     if resume is not None:
         check_checkpoint(resume, record, module)
     logger = None
     if logger_cfg.enabled:
         scale, text = str(cfg.scale.name), OmegaConf.to_yaml(cfg)
-        logger = make_logger(logger_cfg, scale, network, record, settings, text)
-    callbacks = build_callbacks(cfg.get("callbacks"), paths.run_folder(network), logger is not None)
+        logger = make_logger(logger_cfg, scale, network, record, settings, text, budget)
+    callbacks = build_callbacks(cfg.get("callbacks"), files.run_folder, logger is not None)
     bar = any(type(c).__name__ == "TQDMProgressBar" for c in callbacks)
     precision = resolve_precision(cfg.trainer.precision, cfg.trainer.accelerator)
-    trainer = instantiate(
-        cfg.trainer,
-        callbacks=callbacks,
-        logger=logger or False,
-        precision=precision,
-        enable_progress_bar=bar,
-        _convert_="all",
-    )
-    out, metrics_file = paths.checkpoint(network), paths.train_metrics(network)
+    trainer = instantiate(cfg.trainer, callbacks=callbacks, logger=logger or False,
+                          precision=precision, enable_progress_bar=bar,
+                          _convert_="all")  # fmt: skip
     batch = int(cfg.train.datamodule.batch_size)
-    metrics = fit(module, datamodule, trainer, out, metrics_file, batch, resume)
+    metrics = fit(module, datamodule, trainer, files.checkpoint, files.metrics, batch, resume)
+    if budget is not None:
+        metrics["budget"] = budget_record(trainer, budget)
     if trainer.is_global_zero:
         if logger is not None:
             metrics["mlflow_run_id"] = logger.run_id
-            log_model(logger_cfg, network, out, logger, datamodule)
+            log_model(logger_cfg, network, files.checkpoint, logger, datamodule, budget is None)
         from vnrrt.io import write_json
         from vnrrt.model.checkpoint import write_checksum
 
-        metrics["checkpoint_sha256"] = write_checksum(out)
+        metrics["checkpoint_sha256"] = write_checksum(files.checkpoint)
         metrics["threads"] = threads
         metrics["batch_size"] = batch
         metrics["network"] = record["describe"]  # architecture, initialisation, parameters
         metrics["target"] = record["target"]
-        write_json(metrics_file, metrics)
-        shutil.rmtree(paths.run_folder(network), ignore_errors=True)
+        write_json(files.metrics, metrics)
+        shutil.rmtree(files.run_folder, ignore_errors=True)
     return metrics
 
 
-def log_model(logger_cfg: tracking.LoggerConfig, network: str, checkpoint: Path, logger,
-              datamodule) -> None:  # fmt: skip
-    """Log the trained network to the run as an MLflow Model (pytorch flavour) with a
-    signature and an input example, and register it as ``<registry_prefix><network>``."""
-    from vnrrt.io import sha256
+def budget_record(trainer, steps: int) -> dict:
+    """What a budget training adds to its metrics: its steps, epochs and batches per epoch,
+    and how far its learning-rate schedule ran (``schedule_steps`` of ``schedule_total``:
+    equal for a schedule of its own run to its end); ``ValueError`` unless it ran exactly
+    ``steps`` steps."""
+    from vnrrt.training.budget import check_steps
 
-    logger.experiment.set_tag(logger.run_id, "checkpoint_sha256", sha256(checkpoint))
-    if not logger_cfg.log_model:
-        return
-    import mlflow
-    import mlflow.pytorch
-
-    from vnrrt.model.checkpoint import load_network
-
-    net, record = load_network(checkpoint, network)
-    example = datamodule.datasets["val"][0]["image"][None].numpy()  # (1, 3, S, S) float32
-    mlflow.set_tracking_uri(tracking.tracking_uri(logger_cfg.uri))
-    with mlflow.start_run(run_id=logger.run_id):
-        prefix = logger_cfg.registry_prefix
-        registered = prefix + network if prefix else None
-        # pickle: load_model returns the nn.Module itself (any batch size; needs vnrrt installed)
-        mlflow.pytorch.log_model(
-            net,
-            name="model",
-            input_example=example,
-            registered_model_name=registered,
-            serialization_format="pickle",
-            # how to draw its input image, and what it predicts (checked by vnrrt.predict)
-            metadata={"render": dict(record["render"]), "target": dict(record["target"])},
-        )
+    batches = int(trainer.limit_train_batches)
+    check_steps(int(trainer.global_step), steps, batches)
+    configs = trainer.lr_scheduler_configs
+    scheduler = configs[0].scheduler if configs else None
+    total = getattr(scheduler, "total_steps", None)
+    return {"steps": steps, "epochs": int(trainer.current_epoch), "batches_per_epoch": batches,
+            "schedule_steps": None if scheduler is None else int(scheduler.last_epoch),
+            "schedule_total": None if total is None else int(total)}  # fmt: skip
