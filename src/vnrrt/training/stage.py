@@ -223,7 +223,8 @@ def train_network(cfg: DictConfig, network: str, files: TrainFiles,
                           precision=precision, enable_progress_bar=bar,
                           _convert_="all")  # fmt: skip
     batch = int(cfg.train.datamodule.batch_size)
-    metrics = fit(module, datamodule, trainer, files.checkpoint, files.metrics, batch, resume)
+    metrics = fit(module, datamodule, trainer, files.checkpoint, files.metrics, batch, resume,
+                  with_val=budget is not None)  # fmt: skip
     if budget is not None:
         metrics["budget"] = budget_record(trainer, budget)
     if trainer.is_global_zero:

@@ -68,9 +68,9 @@ def summary(
     val: dict | None = None,
 ) -> dict:
     """Metrics of a run: the final validation's metrics (``val``: :func:`validation_metrics`
-    read after fitting; None: read now), test metrics, steps, time, throughput.
-    ``first_step``: the step a resumed run started from; ``fit_seconds`` and the throughput
-    are those of this run's steps only."""
+    read after fitting; None: those left in the trainer, none after a test), test metrics,
+    steps, time, throughput. ``first_step``: the step a resumed run started from;
+    ``fit_seconds`` and the throughput are those of this run's steps only."""
     val = validation_metrics(trainer) if val is None else val
     per_step = batch_size * trainer.world_size
     return {
@@ -102,14 +102,18 @@ def fit(
     metrics_file: Path,
     batch_size: int,
     resume: Path | None = None,
+    with_val: bool = False,
 ) -> dict:
     """Train ``module`` (from ``resume``, a Lightning checkpoint, if given), write the final
-    checkpoint to ``out``, test it and write the metrics to ``metrics_file``; returns them."""
+    checkpoint to ``out``, test it and write the metrics to ``metrics_file``; returns them.
+    ``with_val``: with the final validation's metrics (``val/...``; the budget curve's
+    trainings: its report, the target variants' selection). The pipeline's trainings leave
+    them out: their metrics files are ``dvc metrics show``'s rows."""
     first_step = resumed_step(resume)  # before the run overwrites its last.ckpt
     start = time.perf_counter()
     trainer.fit(module, datamodule=datamodule, ckpt_path=None if resume is None else str(resume))
     seconds = time.perf_counter() - start
-    val = validation_metrics(trainer)  # before the test replaces the trainer's metrics
+    val = validation_metrics(trainer) if with_val else {}  # before the test replaces them
     out.parent.mkdir(parents=True, exist_ok=True)
     save_final(trainer, out)
     tested = trainer.test(module, datamodule=datamodule, verbose=False)[0]
