@@ -2,8 +2,8 @@
 every learned planner of ``eval.planners`` sampling its ``eval.sources`` network, M-VNRRT* at
 the claims' threshold ``planner.tau`` only, not informed, on the random instances of the
 instances file (the comparable map set), every stop rule of the protocol with its trial
-counts (``eval.random_initial``, ``eval.random_optimal``, ``eval.any_angle``) and its paired
-seeds, so that a budget's configurations are compared on the same trials, and the budgets on
+counts (``eval.random_initial``, ``eval.random_optimal``, ``eval.any_angle``), its obstacle
+rule (``eval.zero_obstacles``) and its paired seeds, so that a budget's configurations are compared on the same trials, and the budgets on
 the same instances and seeds.
 """
 
@@ -29,12 +29,14 @@ class BudgetTrials:
     random_optimal: int
     any_angle: bool
     endpoint_radius: float
+    zero_obstacles: bool
 
     def keys(self, tau: float) -> list[ConfigKey]:
         """The configurations, in the protocol's order (``rrt_star``, ``nrrt_star``,
         ``vnrrt_star``, ``m_vnrrt_star@<tau>`` as configured)."""
         ev = Configurations(list(self.planners), dict(self.sources), informed=False,
-                            endpoint_radius=self.endpoint_radius)  # fmt: skip
+                            endpoint_radius=self.endpoint_radius,
+                            zero_obstacles=self.zero_obstacles)  # fmt: skip
         return configurations(ev, [tau], tau)
 
     def counts(self) -> dict[tuple[str, str], int]:

@@ -18,7 +18,6 @@ from vnrrt.config import ConfigError, sections
 from vnrrt.paths import Paths
 
 log = logging.getLogger(__name__)
-EVAL_KEYS = ("random_initial", "random_optimal", "any_angle", "endpoint_radius")
 
 
 def _design(cfg: DictConfig) -> dict:
@@ -31,6 +30,7 @@ def _design(cfg: DictConfig) -> dict:
         "random_optimal": int(ev.random_optimal),
         "any_angle": bool(ev.any_angle),
         "endpoint_radius": float(ev.endpoint_radius),
+        "zero_obstacles": bool(ev.zero_obstacles),
     }
 
 
@@ -61,7 +61,8 @@ def run_budget_trials(cfg: DictConfig, steps: int) -> int:
     heatmaps = paths.budget_heatmaps(steps)
     instances, targets = load(paths.instances, indices, networks, heatmaps, [0])
     log.info("budget %d: %d trial jobs on %d instances", steps, len(jobs), len(instances))
-    heat = HeatSettings(s["oracle"]["radius"], design.endpoint_radius, targets)
+    heat = HeatSettings(s["oracle"]["radius"], design.endpoint_radius, targets,
+                        zero_obstacles=design.zero_obstacles)  # fmt: skip
     table = run_jobs(jobs, instances, s["seed"], s["workers"], planner, heat)
     write_table(table, paths.budget_trials(steps))
     return len(table)
