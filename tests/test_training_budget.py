@@ -1,11 +1,13 @@
 """The budget curve (issue 24): a budget of N steps is a whole training of N steps (its own
-one-cycle schedule, run to its end; the budget of the training's own steps is that training),
-its heatmap metrics are those of stage ``predict_metrics`` on the same checkpoint (and a
-uniform map's are what a uniform map gives), and a smoke-sized curve (64x64 maps, budgets of
-1 and 2 steps) renders its table, trends and figures from paired trials."""
+one-cycle schedule, run to its end; that the budget of a training's own steps is that
+training: the slow DVC test in tests/test_pipeline.py), its heatmap metrics are those of
+stage ``predict_metrics`` on the same checkpoint (and a uniform map's are what a uniform map
+gives), and a smoke-sized curve (64x64 maps, budgets of 2 and 4 steps) renders its table,
+trends and figures from paired trials."""
 
 import json
 import math
+import shutil
 from pathlib import Path
 
 import numpy as np
@@ -22,7 +24,7 @@ from vnrrt.evaluation.instances import build_instances
 from vnrrt.evaluation.table import SEEDED_COLUMNS, read_table
 from vnrrt.evaluation.training_budget.stage import run_budget_report, run_budget_trials
 from vnrrt.model.checkpoint import read_checkpoint
-from vnrrt.predict.stage import run_budget_predict
+from vnrrt.predict.stage import run_budget_predict, run_predict_metrics, run_predict_part
 from vnrrt.training.budget import batches_per_epoch
 from vnrrt.training.stage import run_budget_train
 from vnrrt.validate import validate_config
@@ -120,8 +122,9 @@ def _view(cfg, stage: str):
 def curve(small_data, tmp_path_factory):
     """The curve end to end on the 64x64 data through the stages' entry points, each seeing
     its declared parameters only: budgets of 2 and 4 steps over 2 epochs (1 and 2 batches
-    each), both networks, their heatmaps, the trials and the report. Returns the config and
-    the summary."""
+    each), both networks, their heatmaps, the trials and the report; then budget 4's networks
+    through the pipeline's predict@0 and predict_metrics. Returns the config and the
+    summary."""
     out = tmp_path_factory.mktemp("curve")
     cfg = small_cfg(small_data, out, *CURVE)
     _instances(cfg, small_data)
@@ -135,13 +138,22 @@ def curve(small_data, tmp_path_factory):
     finally:
         torch.set_num_threads(before)
     summary = run_budget_report(_view(cfg, "budget_report@training_budget"), "training_budget")
+    models = Path(cfg.paths.models)  # budget 4's networks as the pipeline's, for predict_metrics
+    for name in NETWORKS:
+        for suffix in (".ckpt", ".ckpt.sha256"):
+            shutil.copy(models / f"budget/4/{name}{suffix}", models / f"{name}{suffix}")
+    try:
+        run_predict_part(_view(cfg, "predict@0"), 0)
+    finally:
+        torch.set_num_threads(before)
+    run_predict_metrics(_view(cfg, "predict_metrics"))
     return cfg, summary
 
 
 def test_a_budget_of_n_steps_is_a_whole_training_of_n_steps(curve):
     """Each budget ends at its step with a schedule sized to it and run to its end (the rate
     of its last step is the schedule's final value, not that of a longer schedule cut short).
-    That the budget of a training's own steps is that training: tests/test_pipeline.py."""
+    That the budget of a training's own steps is that training: tests/test_pipeline.py (slow)."""
     cfg, summary = curve
     models = Path(cfg.paths.models)
     for b in summary["budgets"]:
@@ -165,11 +177,25 @@ def test_a_budget_of_n_steps_is_a_whole_training_of_n_steps(curve):
         assert not (models / f"budget/{steps}/checkpoints/vertexnet").exists()  # cleaned up
 
 
+def test_a_budget_stage_measures_its_heatmaps_as_predict_metrics_does(curve):
+    """Budget 4's networks through budget_predict@4, and through predict@0 and
+    predict_metrics: the same metrics, settings and targets (all but the inference time)."""
+    cfg, _ = curve
+    got = json.loads((Path(cfg.paths.budget) / "4/predict.json").read_text())
+    want = json.loads(Path(cfg.paths.predict_metrics).read_text())
+    assert got["settings"] == want["settings"] and set(got["networks"]) == set(NETWORKS)
+    for name in NETWORKS:
+        a, b = (
+            {k: v for k, v in r["networks"][name].items() if k != "ms_per_map"} for r in (got, want)
+        )
+        assert a == b, name
+
+
 def test_a_uniform_map_measures_as_a_uniform_map(curve):
     """A budget's uniform-map metrics are the pipeline's own uniform shares (computed apart
     by :class:`vnrrt.model.metrics.MassNear`), and its interior AP is the share of
     interior-vertex pixels among the pixels counted (an AP's chance level). That the networks'
-    metrics are predict_metrics' on the same checkpoint: tests/test_pipeline.py."""
+    metrics are predict_metrics': the test above."""
     cfg, _ = curve
     got = json.loads((Path(cfg.paths.budget) / "4/predict.json").read_text())
     uniform, network = got["uniform"], got["networks"]["vertexnet"]
