@@ -6,10 +6,10 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 export PATH := $(CURDIR)/$(BIN):$(PATH)
 
-.PHONY: help setup test test-all lint format params repro repro-cpu bench clean
+.PHONY: help setup test test-all lint format params repro repro-cpu repro-cpu-budget-seed1 bench clean
 
 help:  ## list the targets
-	@grep -E '^[a-z-]+:.*## ' $(MAKEFILE_LIST) | awk -F':.*## ' '{printf "  %-10s %s\n", $$1, $$2}'
+	@grep -E '^[a-z0-9-]+:.*## ' $(MAKEFILE_LIST) | awk -F':.*## ' '{printf "  %-10s %s\n", $$1, $$2}'
 
 $(STAMP): pyproject.toml requirements/constraints.txt
 	test -x $(BIN)/python || $(PY) -m venv $(VENV)
@@ -40,13 +40,24 @@ repro: $(STAMP)  ## run the whole pipeline (dvc repro) at the default scale
 	$(BIN)/dvc repro
 
 CPU_REPORTS := reports/cpu
-repro-cpu: $(STAMP)  ## the CPU study scale (~80 min on 2 cores): both networks at train.seed 1, then the whole pipeline at seed 0; reports copied to reports/cpu/, the per-trial tables behind them to reports/cpu/results/
+# Wall time on an idle 2-core machine: ~80 min for both networks at train.seed 1 and the pipeline
+# at seed 0, plus ~75 min for the training-budget curve at seed 0 (conf/scale/cpu.yaml budget:
+# 2 networks x 9,000 steps at the 0.21-0.22 s a step of reports/cpu/metrics/train_*.json, ~64
+# min, with their tests, heatmaps, trials and report).
+repro-cpu: $(STAMP)  ## the CPU study scale (~155 min on 2 cores): both networks at train.seed 1, then the whole pipeline and the training-budget curve at seed 0; reports copied to reports/cpu/, the per-trial tables behind them to reports/cpu/results/
 	$(BIN)/dvc exp run -S scale=cpu -S train.seed=1 predict_metrics
 	rm -rf $(CPU_REPORTS) && mkdir -p $(CPU_REPORTS)/seed1
 	cp reports/metrics/train_*.json reports/metrics/predict.json $(CPU_REPORTS)/seed1/
 	$(BIN)/dvc exp run -S scale=cpu
-	cp -r reports/paper_comparison.md reports/sampling_ideas.md reports/metrics reports/figures $(CPU_REPORTS)/
+	cp -r reports/paper_comparison.md reports/sampling_ideas.md reports/training_budget.md reports/metrics reports/figures $(CPU_REPORTS)/
 	$(BIN)/python -m vnrrt.evaluation.recompute export --params params.yaml --out $(CPU_REPORTS)/results
+
+repro-cpu-budget-seed1: $(STAMP)  ## after repro-cpu: the training-budget curve at train.seed 1 (~75 min on 2 cores); to reports/cpu/seed1/
+	$(BIN)/dvc exp run -S scale=cpu -S train.seed=1 budget_report@training_budget
+	mkdir -p $(CPU_REPORTS)/seed1/figures $(CPU_REPORTS)/seed1/metrics
+	cp reports/training_budget.md $(CPU_REPORTS)/seed1/
+	cp reports/metrics/training_budget.json $(CPU_REPORTS)/seed1/metrics/
+	rm -rf $(CPU_REPORTS)/seed1/figures/budget && cp -r reports/figures/budget $(CPU_REPORTS)/seed1/figures/
 
 bench: $(STAMP)  ## run the benchmarks
 	for f in benchmarks/bench_*.py; do $(BIN)/python $$f || exit 1; done

@@ -151,11 +151,21 @@ def declared_params(stage: str) -> dict:
 
     cfg = compose()
     entry = yaml.safe_load((REPO / "dvc.yaml").read_text())["stages"][stage]
-    if "foreach" in entry:  # ${scale.shards} -> the first id
-        items = OmegaConf.select(cfg, entry["foreach"].strip("${}"))
-        stage = f"{stage}@{items[0]}"
+    if "foreach" in entry:  # ${scale.shards} -> the first id (a stand-in for an empty list)
+        stage = f"{stage}@{_first(cfg, entry['foreach'])}"
+    if "matrix" in entry:  # the first value of each axis: stage@<a>-<b>
+        stage = f"{stage}@{'-'.join(_first(cfg, axis) for axis in entry['matrix'].values())}"
     view = restrict(cfg, stage_params(stage, REPO / "dvc.yaml"), always=())
     return OmegaConf.to_container(view, resolve=True)
+
+
+def _first(cfg, items: str) -> str:
+    """The first item of a ``foreach``/``matrix`` list ``${key}`` of ``cfg``; ``0`` where the
+    default composition leaves it empty (the budget stages: their keys name no item)."""
+    from omegaconf import OmegaConf
+
+    values = OmegaConf.select(cfg, items.strip("${}"))
+    return str(values[0]) if values else "0"
 
 
 def stage_scripts() -> dict[str, Path]:

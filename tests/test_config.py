@@ -135,6 +135,14 @@ def test_a_stage_sees_only_what_it_declares(repo):
         stage_params("no_such_stage", repo / "dvc.yaml")
 
 
+def test_a_matrix_stage_names_each_axis_of_its_item(repo):
+    """``budget_train@<network>-<steps>``: ``${item.network}`` in its params is the network."""
+    keys = stage_params("budget_train@nrrtnet-600", repo / "dvc.yaml")
+    assert "networks.nrrtnet" in keys and not [k for k in keys if "${" in k or "vertexnet" in k]
+    with pytest.raises(ConfigError, match="expected budget_train@<network>-<steps>"):
+        stage_params("budget_train@nrrtnet", repo / "dvc.yaml")
+
+
 def test_every_section_of_the_default_params_validates(repo):
     typed = validate_config(load_params(repo / "params.yaml"))
     assert isinstance(typed["scale"], ScaleConfig) and isinstance(typed["data"], DataConfig)

@@ -37,6 +37,10 @@ from vnrrt.maps.config import DataConfig
 from vnrrt.paths import Paths, stage_outputs
 
 SHARDS = Path("data/smoke/shards")
+# The training-budget curve's stages (conf/budget: none at smoke): run by the slow test at the
+# end, at one budget of the pipeline training's own 3 steps (so they must reproduce it).
+BUDGET_STAGES = {"budget_train", "budget_predict", "budget_trials", "budget_report"}
+ONE_BUDGET = ["budget.steps=[3]", "budget.report=[training_budget]"]
 AUDIT = Path(__file__).resolve().parent / "write_audit"
 
 
@@ -317,15 +321,17 @@ NOT_OUTPUTS = ("mlflow.db", "mlartifacts/")  # the MLflow store: runs, not pipel
 
 
 def _stage_of(argv: list[str]) -> tuple[str, str | None]:
-    """``(stage, item)`` of a stage script's command line: ``stages/trials.py --part 1``."""
+    """``(stage, item)`` of a stage script's command line: ``stages/trials.py --part 1``,
+    ``stages/budget_train.py --network vertexnet --steps 3`` (item ``vertexnet-3``)."""
     name = Path(argv[0]).stem
-    return name, (argv[2] if len(argv) > 2 and argv[1].startswith("--") else None)
+    values = argv[2::2] if len(argv) > 2 and argv[1].startswith("--") else []
+    return name, ("-".join(values) if values else None)
 
 
-def test_every_stage_writes_exactly_its_outputs(workdir, repo):
-    """Each stage process (recorded by the write audit) creates or changes exactly the files
-    of its outputs in ``dvc.yaml`` (:func:`vnrrt.paths.stage_outputs`, files under an output
-    folder included), besides the MLflow store; and ``dvc.yaml`` declares the same outputs."""
+def stages_writing_their_outputs(workdir: Path) -> set[str]:
+    """The stages whose processes the write audit recorded, each checked to have created or
+    changed exactly the files of its outputs in ``dvc.yaml`` (:func:`vnrrt.paths.stage_outputs`,
+    files under an output folder included), besides the MLflow store."""
     cfg = yaml.safe_load((workdir / "params.yaml").read_text())
     paths = section(cfg, "paths", Paths)
     entries = [json.loads(line) for line in write_log(workdir).read_text().splitlines()]
@@ -340,8 +346,14 @@ def test_every_stage_writes_exactly_its_outputs(workdir, repo):
             assert any(path == o or path.startswith(o + "/") for o in outs), (stage, item, path)
         for out in outs:  # every declared output exists (an unchanged one is not rewritten)
             assert (workdir / out).exists(), (stage, out)
+    return seen
+
+
+def test_every_stage_writes_exactly_its_outputs(workdir, repo):
+    """Each stage process writes exactly its outputs (:func:`stages_writing_their_outputs`),
+    and every stage of ``dvc.yaml`` ran (the budget curve's: the slow test at the end)."""
     stages = yaml.safe_load((repo / "dvc.yaml").read_text())["stages"]
-    assert seen == set(stages)
+    assert stages_writing_their_outputs(workdir) == set(stages) - BUDGET_STAGES
 
 
 def test_the_committed_tables_recompute_both_reports_byte_for_byte(workdir, tmp_path):
@@ -622,3 +634,49 @@ def test_a_run_killed_after_its_trainings_does_not_train_again(workdir):
     assert "Stage 'train@vertexnet' is cached - skipping run" in again
     assert "Running stage 'report'" in again
     _back_to_the_commit(workdir)
+
+
+@pytest.mark.slow
+def test_the_budget_stages_reproduce_the_training_of_their_steps(workdir):
+    """The budget curve's stages by DVC at one budget of the smoke training's own 3 steps
+    (~2.5 minutes: five more stage processes): each writes exactly its outputs; the budget
+    has the pipeline training's settings, so the same checkpoint bytes; its heatmap metrics
+    are predict_metrics' on them (up to the float16 heatmaps of another batching); its
+    report; one MLflow run per budget training, with the budget as a param, and no model
+    registered beside the pipeline's networks. Nothing else runs again."""
+    from mlflow import MlflowClient
+
+    _back_to_the_commit(workdir)
+    client = MlflowClient(f"sqlite:///{workdir / 'mlflow.db'}")
+    registered = len(client.search_model_versions("name='vnrrt-vertexnet'"))
+    seed = [f"seed={yaml.safe_load((workdir / 'params.yaml').read_text())['seed']}"]
+    (workdir / "params.yaml").write_text(dump(compose(["scale=smoke", *seed, *ONE_BUDGET])))
+    out = run(["dvc", "repro"], workdir)
+    ran = {line.split("'")[1].split("@")[0] for line in out.splitlines() if "Running" in line}
+    assert ran == {"validate", *BUDGET_STAGES}, out
+    assert stages_writing_their_outputs(workdir) >= BUDGET_STAGES
+
+    metrics, budget = workdir / "reports/metrics", workdir / "data/smoke/budget/3"
+    predict = json.loads((metrics / "predict.json").read_text())["networks"]
+    again = json.loads((budget / "predict.json").read_text())["networks"]
+    sha = {}
+    for name in ("vertexnet", "nrrtnet"):
+        main = json.loads((metrics / f"train_{name}.json").read_text())
+        trained = json.loads((budget / f"train_{name}.json").read_text())
+        assert trained["checkpoint_sha256"] == main["checkpoint_sha256"], name
+        assert trained["budget"]["schedule_steps"] == trained["budget"]["schedule_total"] == 3
+        sha[name] = trained["checkpoint_sha256"]
+        numbers = [k for k, v in predict[name].items() if k != "ms_per_map" and v != str(v)]
+        want = {k: predict[name][k] for k in numbers}
+        assert {k: again[name][k] for k in numbers} == pytest.approx(want, rel=1e-3, abs=1e-5)
+        assert again[name]["target"] == predict[name]["target"]
+    report = (workdir / "reports/training_budget.md").read_text()
+    assert "## What the curve says" in report and "one budget: no trend" in report
+    exp = client.get_experiment_by_name("vnrrt-smoke").experiment_id
+    runs = client.search_runs([exp], filter_string="tags.budget_steps = '3'")
+    stages = sorted(r.data.tags["dvc_stage"] for r in runs)
+    assert stages == ["budget_train@nrrtnet-3", "budget_train@vertexnet-3"]
+    for r in runs:
+        assert r.data.params["budget.steps"] == "3" and r.info.run_name.endswith(" budget 3")
+        assert r.data.tags["checkpoint_sha256"] == sha[r.data.tags["kind"]]
+    assert len(client.search_model_versions("name='vnrrt-vertexnet'")) == registered

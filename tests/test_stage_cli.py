@@ -43,6 +43,15 @@ def test_bad_params_exit_2_with_one_line(work, tmp_path, setup, message):
     assert "Traceback" not in out.stderr and out.stderr.startswith("stage validate: error: ")
 
 
+def test_a_matrix_stage_takes_each_axis_and_fails_on_bad_input_in_one_line(work):
+    """``budget_train --network nrrtnet --steps 7``: named ``budget_train@nrrtnet-7`` (its
+    parameters found), then a budget that is no multiple of the epochs: status 2, one line."""
+    out = run_stage(work, "stages/budget_train.py", "--network", "nrrtnet", "--steps", "7")
+    assert out.returncode == 2 and out.stderr.count("\n") == 1, out.stderr
+    assert out.stderr.startswith("stage budget_train@nrrtnet-7: error: invalid config value "
+                                 "budget.steps=7: each budget must be a multiple")  # fmt: skip
+
+
 def test_a_stage_that_succeeds_exits_0(work):
     out = run_stage(work, "stages/validate.py")
     assert out.returncode == 0, out.stderr

@@ -1,5 +1,5 @@
-"""Every key of the evaluation's config sections (``eval``, ``stats``, ``oracle``, ``regime``)
-reaches the stages that declare it: the config is composed with every key changed (Hydra
+"""Every key of the evaluation's config sections (``eval``, ``stats``, ``oracle``, ``regime``,
+``budget``) reaches the stages that declare it: the config is composed with every key changed (Hydra
 overrides, as ``dvc exp run -S`` passes them), each stage whose ``dvc.yaml`` entry declares a
 key (or its section) sees exactly its declared parameters (:func:`vnrrt.config.restrict`), and
 its typed settings hold the new value. A key a stage declares but ignores, or a dataclass
@@ -17,6 +17,7 @@ from vnrrt.config import compose, restrict, stage_params
 from vnrrt.evaluation.paper_comparison.stage import evaluate_settings, report_settings
 from vnrrt.evaluation.sampling_ideas.stage import ideas_settings, part_settings
 from vnrrt.evaluation.stage import instances_settings, trials_settings
+from vnrrt.evaluation.training_budget import stage as budget
 from vnrrt.validate import validate_config
 
 SETTINGS = {
@@ -27,6 +28,8 @@ SETTINGS = {
     "oracle": lambda cfg: part_settings(cfg, "oracle"),
     "regime": lambda cfg: part_settings(cfg, "regime"),
     "ideas": ideas_settings,
+    "budget_trials": budget.trials_settings,
+    "budget_report": budget.report_settings,
     "validate": validate_config,
 }
 DICT_VALUES = ("sources", "families")  # keys whose values are dicts
@@ -74,7 +77,10 @@ CHANGED = {  # key -> a valid value other than the default's
     "regime.configurations": ["rrt_star", "nrrt_star"],
     "regime.random_maps": 4,
     "regime.parts": [0, 1, 2],
+    "budget.steps": [10, 20],  # multiples of the quick scale's trainer.max_epochs
+    "budget.report": ["training_budget"],
 }
+SECTIONS = ("eval", "stats", "oracle", "regime", "budget")
 
 
 def _override(key: str, value) -> str:
@@ -115,7 +121,7 @@ def _view(cfg, stage: str):
 
 def test_the_changed_values_differ_from_the_defaults_and_cover_every_key():
     default = compose()
-    for section in ("eval", "stats", "oracle", "regime"):
+    for section in SECTIONS:
         keys = {f"{section}.{k}" for k in default[section]}
         assert keys == {k for k in CHANGED if k.startswith(section + ".")}, section
     for key, value in CHANGED.items():

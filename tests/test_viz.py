@@ -13,6 +13,7 @@ from vnrrt.data.build_named import build_named_maps
 from vnrrt.data.config import LabelsConfig
 from vnrrt.data.reader import Shard
 from vnrrt.planners import plan
+from vnrrt.viz.budget import budget_figure
 from vnrrt.viz.evaluation import convergence_figure, heatmaps_figure, improvements_figure
 from vnrrt.viz.ideas import quality_figure, regime_figure
 from vnrrt.viz.maps import named_maps_figure
@@ -235,6 +236,83 @@ def test_regime_heatmap_cells_colour_bar_and_significance_marks():
     assert [t.get_text() for t in ax.texts] == ["4.00*", "0.50*", "2.00", "1.00"]
     assert [t.get_text() for t in ax.get_xticklabels()] == ["NRRT*", "VNRRT*"]
     assert [t.get_text() for t in ax.get_yticklabels()] == ["eta=5", "eta=20"]
+
+
+def _budget_summary() -> dict:
+    """A summary of two budgets (:mod:`vnrrt.evaluation.training_budget.summary`'s shape)."""
+    keys, ratio_keys = (
+        ["rrt_star", "nrrt_star", "vnrrt_star", "m_vnrrt_star@0.6"],
+        ["vnrrt_star", "m_vnrrt_star@0.6"],
+    )
+    stops = ["initial", "optimal"]
+
+    def cell(v):
+        return {"speedup": v, "ci_low": v * 0.8, "ci_high": v * 1.25}
+
+    budgets = []
+    for images, grow in ((4800, 1.0), (38400, 1.5)):
+        over = {
+            s: {"iterations": {k: cell(grow * (j + 1)) for j, k in enumerate(keys[1:])}}
+            for s in stops
+        }
+        ratios = {s: {"iterations": {k: cell(grow) for k in ratio_keys}} for s in stops}
+        nets = {
+            n: {
+                "heatmap": {
+                    "mass_near_interior": {"ratio": 2.0 * grow},
+                    "mass_near_path": {"ratio": 5.0},
+                }
+            }
+            for n in ("vertexnet", "nrrtnet")
+        }
+        budgets.append({"images": images, "speedups": over, "ratios": ratios, "networks": nets})
+    settings = {
+        "keys": keys,
+        "ratio_keys": ratio_keys,
+        "stops": stops,
+        "eps": 0.02,
+        "level": 0.8,
+        "train_seed": 1,
+        "heatmap": {"radius": 2.0},
+    }
+    return {"settings": settings, "budgets": budgets, "metrics": ["iterations"]}
+
+
+def test_budget_figure_lines_per_planner_and_stop_with_bands_and_masses():
+    fig = budget_figure(_budget_summary(), "iterations")
+    shown = [ax for ax in fig.axes if ax.get_visible()]
+    assert [ax.get_title() for ax in shown] == [
+        "over RRT*, initial solution",
+        "over RRT*, within 2% of A*",
+        "VNRRT* / NRRT* (paired)",
+        "M-VNRRT* τ=0.6 / NRRT* (paired)",
+        "heatmap mass within 2 px, x a uniform map's",
+    ]
+    for ax in shown:
+        assert ax.get_xscale() == ax.get_yscale() == "log" and ax.get_xlabel() == (
+            "training images seen"
+        )
+        assert _visible_tick_labels(ax.xaxis) == ["4,800", "38,400"]
+    planners = shown[0]
+    assert [line.get_label() for line in planners.get_lines()[:3]] == [
+        "NRRT*",
+        "VNRRT*",
+        "M-VNRRT* τ=0.6",
+    ]
+    assert len(planners.collections) == 3  # a CI band per line
+    np.testing.assert_allclose(planners.get_lines()[1].get_ydata(), [2.0, 3.0])
+    assert [line.get_label() for line in shown[2].get_lines()[:2]] == [
+        "initial solution",
+        "within 2% of A*",
+    ]
+    masses = [line.get_label() for line in shown[4].get_lines()]
+    assert masses == [
+        "vertexnet: near the interior vertices",
+        "vertexnet: near the path",
+        "nrrtnet: near the interior vertices",
+        "nrrtnet: near the path",
+    ]
+    assert "80% CI" in fig._suptitle.get_text() and "train.seed 1" in fig._suptitle.get_text()
 
 
 def test_validation_figure_rows_and_colour_bars():

@@ -51,6 +51,8 @@ def paths(data: Path, out: Path) -> list[str]:
         f"paths.heatmaps={out / 'heatmaps'}",
         f"paths.timing={out / 'timing'}",
         f"paths.instances={out / 'instances.npz'}",
+        f"paths.budget={out / 'budget'}",
+        f"paths.budget_report={out / 'training_budget.md'}",
         f"logger.uri=sqlite:///{out / 'mlflow.db'}",
         f"logger.artifact_location={out / 'mlartifacts'}",
     ]

@@ -134,7 +134,9 @@ _MISSING = object()
 
 def stage_params(stage: str, dvc_yaml: str | Path = "dvc.yaml") -> list[str]:
     """The dotted ``params`` keys of stage ``stage`` (``name`` or ``name@item``; ``${item}``
-    in a key becomes ``item``) in ``dvc_yaml``; :class:`ConfigError` if it is not there."""
+    in a key becomes ``item``; of a ``matrix`` stage ``name@a-b``, ``${item.<k>}`` becomes
+    the value of its k-th matrix key) in ``dvc_yaml``; :class:`ConfigError` if it is not
+    there."""
     import yaml
 
     path = Path(dvc_yaml)
@@ -146,7 +148,16 @@ def stage_params(stage: str, dvc_yaml: str | Path = "dvc.yaml") -> list[str]:
         raise ConfigError(f"stage {name!r} is not in {path}")
     entry = stages[name].get("do", stages[name])
     keys = [k for k in entry.get("params", []) if isinstance(k, str)]
-    return [k.replace("${item}", item) for k in keys]
+    names = {"${item}": item}
+    if "matrix" in stages[name]:
+        axes = list(stages[name]["matrix"])
+        values = item.split("-", len(axes) - 1)
+        if len(values) != len(axes):
+            raise ConfigError(f"stage {stage!r}: expected {name}@<{'>-<'.join(axes)}>")
+        names = {f"${{item.{a}}}": v for a, v in zip(axes, values, strict=True)}
+    for placeholder, value in names.items():
+        keys = [k.replace(placeholder, value) for k in keys]
+    return keys
 
 
 def _leaves(doc: Any, prefix: str = "") -> dict[str, Any]:

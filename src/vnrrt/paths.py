@@ -37,12 +37,15 @@ class Paths:
     oracle: str
     regime: str
     ideas_summary: str
+    budget: str
     models: str
+    budget_models: str
     figures: str
     metrics: str
     plots: str
     report: str
     ideas_report: str
+    budget_report: str
     paper_tables: str
     paper_settings: str
     gpu_runs: str
@@ -56,6 +59,8 @@ class Paths:
     convergence_plots: str
     evaluation_figures: str
     ideas_figures: str
+    budget_summary: str
+    budget_figures: str
 
     def validate(self) -> None:
         """Raise :class:`ConfigError` for an empty path."""
@@ -83,6 +88,36 @@ class Paths:
         """Lightning's last-epoch checkpoints of a training in progress (removed after)."""
         return Path(self.models) / "checkpoints" / network
 
+    def training(self, network: str) -> TrainFiles:
+        """The files of stage ``train@<network>``."""
+        return TrainFiles(self.checkpoint(network), self.checksum(network),
+                          self.train_metrics(network), self.run_folder(network))  # fmt: skip
+
+    def budget_training(self, network: str, steps: int) -> TrainFiles:
+        """The files of stage ``budget_train@<network>-<steps>``: the checkpoint under
+        ``budget_models/<steps>/``, the metrics in :meth:`budget_folder`."""
+        models = Path(self.budget_models) / str(int(steps))
+        return TrainFiles(models / f"{network}.ckpt", models / f"{network}.ckpt.sha256",
+                          self.budget_folder(steps) / f"train_{network}.json",
+                          models / "checkpoints" / network)  # fmt: skip
+
+    def budget_folder(self, steps: int) -> Path:
+        """What the stages of training budget ``steps`` write besides the checkpoints."""
+        return Path(self.budget) / str(int(steps))
+
+    def budget_heatmaps(self, steps: int) -> Path:
+        """The folder of the budget's heatmaps (``part_0.npz``, stage ``budget_predict``)."""
+        return self.budget_folder(steps) / "heatmaps"
+
+    def budget_predict_metrics(self, steps: int) -> Path:
+        """The budget's heatmap metrics, as ``predict_metrics`` writes them (and a uniform
+        map's)."""
+        return self.budget_folder(steps) / "predict.json"
+
+    def budget_trials(self, steps: int) -> Path:
+        """The budget's trial table (stage ``budget_trials@<steps>``)."""
+        return self.budget_folder(steps) / "trials.csv"
+
     def heatmaps_part(self, part: int) -> Path:
         """Heatmaps of prediction part ``part`` (stage ``predict@<part>``)."""
         return heatmaps_part_file(self.heatmaps, part)
@@ -104,6 +139,21 @@ class Paths:
         return table_part_file(self.regime, part)
 
 
+@dataclass(frozen=True)
+class TrainFiles:
+    """What one training writes: the final ``checkpoint``, its sidecar ``checksum``, the
+    ``metrics`` JSON, and the ``run_folder`` of Lightning's ``last.ckpt`` (while it runs)."""
+
+    checkpoint: Path
+    checksum: Path
+    metrics: Path
+    run_folder: Path
+
+    def outputs(self) -> list[Path]:
+        """The files the training's stage declares (the run folder is removed after)."""
+        return [self.checkpoint, self.checksum, self.metrics]
+
+
 def shard_file(shards_dir: str | Path, shard_id: int) -> Path:
     """Shard ``shard_id`` in ``shards_dir``: ``shard_<id>.npz``."""
     return Path(shards_dir) / f"shard_{shard_id}.npz"
@@ -120,8 +170,8 @@ def table_part_file(directory: str | Path, part: int) -> Path:
 
 
 def stage_outputs(stage: str, paths: Paths, item=None) -> list[Path]:
-    """The files (and output folders) stage ``stage`` (``item``: its part, shard id or
-    network) writes, as ``dvc.yaml`` declares them."""
+    """The files (and output folders) stage ``stage`` (``item``: its part, shard id, network,
+    budget steps or ``<network>-<steps>``) writes, as ``dvc.yaml`` declares them."""
     p = paths
     table = {
         "validate": lambda: [p.validated],
@@ -129,7 +179,14 @@ def stage_outputs(stage: str, paths: Paths, item=None) -> list[Path]:
         "named_maps": lambda: [p.named_maps, p.named_maps_figure],
         "manifest": lambda: [p.manifest, p.data_metrics],
         "instances": lambda: [p.instances],
-        "train": lambda: [p.checkpoint(item), p.checksum(item), p.train_metrics(item)],
+        "train": lambda: p.training(item).outputs(),
+        "budget_train": lambda: p.budget_training(*_network_steps(item)).outputs(),
+        "budget_predict": lambda: [
+            heatmaps_part_file(p.budget_heatmaps(int(item)), 0),
+            p.budget_predict_metrics(int(item)),
+        ],
+        "budget_trials": lambda: [p.budget_trials(int(item))],
+        "budget_report": lambda: [p.budget_summary, p.budget_report, p.budget_figures],
         "predict": lambda: [p.heatmaps_part(int(item)), p.timing_part(int(item))],
         "predict_metrics": lambda: [p.predict_metrics, p.heatmaps_figure],
         "trials": lambda: [p.trials_part(int(item))],
@@ -142,3 +199,11 @@ def stage_outputs(stage: str, paths: Paths, item=None) -> list[Path]:
     if stage not in table:
         raise ConfigError(f"no outputs known for stage {stage!r}; known: {sorted(table)}")
     return [Path(f) for f in table[stage]()]
+
+
+def _network_steps(item: str) -> tuple[str, int]:
+    """``("vertexnet", 600)`` of a ``budget_train`` item ``vertexnet-600`` (DVC's matrix name)."""
+    network, _, steps = str(item).rpartition("-")
+    if not network or not steps.isdigit():
+        raise ConfigError(f"budget_train item {item!r} is not <network>-<steps>")
+    return network, int(steps)

@@ -66,19 +66,24 @@ def stage_main(
     arg: str | None = None,
     arg_type: type = int,
     arg_help: str = "",
+    more: tuple[tuple[str, type, str], ...] = (),
 ) -> None:
     """Parse ``[--<arg> VALUE] [--params params.yaml]``, log at INFO, run ``fn(params)`` or
-    ``fn(params, value)`` and exit with its status (:data:`EXIT_HELP`). ``params`` holds only
-    what ``stage``'s entry in ``dvc.yaml`` (of the working directory, where DVC runs stages,
-    else beside the parameters file) declares (:func:`vnrrt.config.restrict`)."""
+    ``fn(params, value)`` and exit with its status (:data:`EXIT_HELP`). ``more``: further
+    ``(name, type, help)`` arguments after ``arg`` (a ``matrix`` stage, named
+    ``stage@<value>-<value>``), passed to ``fn`` in order. ``params`` holds only what
+    ``stage``'s entry in ``dvc.yaml`` (of the working directory, where DVC runs stages, else
+    beside the parameters file) declares (:func:`vnrrt.config.restrict`)."""
     raw = argparse.RawDescriptionHelpFormatter
     parser = argparse.ArgumentParser(description=doc, epilog=EXIT_HELP, formatter_class=raw)
-    if arg:
-        parser.add_argument(f"--{arg}", type=arg_type, required=True, help=arg_help)
+    options = ([(arg, arg_type, arg_help)] if arg else []) + list(more)
+    for option, kind, text in options:
+        parser.add_argument(f"--{option}", type=kind, required=True, help=text)
     parser.add_argument("--params", default="params.yaml", help="composed parameters (DVC)")
     args = parser.parse_args()
     logging.basicConfig(level=logging.INFO, format="%(levelname)s %(name)s: %(message)s")
-    name = stage if not arg else f"{stage}@{getattr(args, arg)}"
+    values = [getattr(args, option) for option, _, _ in options]
+    name = f"{stage}@{'-'.join(str(v) for v in values)}" if values else stage
 
     def run() -> int:
         from vnrrt.config import (
@@ -94,7 +99,7 @@ def stage_main(
         cfg = load_params(params)
         dvc_yaml = Path("dvc.yaml") if Path("dvc.yaml").is_file() else params.parent / "dvc.yaml"
         view = restrict(cfg, stage_params(name, dvc_yaml))
-        fn(view, getattr(args, arg)) if arg else fn(view)
+        fn(view, *values)
         return EXIT_OK
 
     sys.exit(run_reporting(f"stage {name}", run))

@@ -22,6 +22,7 @@ from vnrrt.maps.config import DataConfig
 from vnrrt.paths import Paths
 from vnrrt.planners.config import PlannerConfig
 from vnrrt.tracking import LoggerConfig
+from vnrrt.training.budget import BudgetConfig, batches_per_epoch
 
 
 def _taus(planner: PlannerConfig) -> None:
@@ -107,7 +108,10 @@ def validate_config(cfg: DictConfig) -> dict:
         "regime": section(cfg, "regime", RegimeConfig),
         "paths": section(cfg, "paths", Paths),
         "logger": section(cfg, "logger", LoggerConfig),
+        "budget": section(cfg, "budget", BudgetConfig),
     }
+    for steps in typed["budget"].steps:
+        batches_per_epoch(steps, int(cfg.trainer.max_epochs))
     _taus(typed["planner"])
     networks = _networks(cfg)
     for planner, source in typed["eval"].sources.items():

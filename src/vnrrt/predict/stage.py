@@ -5,12 +5,15 @@
   ``predict.threads``; the inference time goes to ``paths.timing_part(k)``);
 * ``predict_metrics``: the heatmap metrics over the named maps and the random instances with
   their settings, the inference time per map (``paths.predict_metrics``) and Fig. 3
-  (``paths.heatmaps_figure``); the MLflow run ``predict <scale>`` (:mod:`vnrrt.predict.runs`).
+  (``paths.heatmaps_figure``); the MLflow run ``predict <scale>`` (:mod:`vnrrt.predict.runs`);
+* ``budget_predict@<steps>``: both, for the networks of one training budget (the budget
+  curve, :mod:`vnrrt.training.budget`), with a uniform map's metrics beside them.
 """
 
 from __future__ import annotations
 
 import logging
+from pathlib import Path
 
 import numpy as np
 import torch
@@ -29,17 +32,32 @@ def pick_device(device: str) -> torch.device:
     return torch.device(device)
 
 
-def _networks(names: list[str], paths: Paths) -> dict:
-    """``{name: (network, record, checkpoint sha256)}`` of each network of ``names``."""
+def _networks(checkpoints: dict[str, Path]) -> dict:
+    """``{name: (network, record, checkpoint sha256)}`` of each network's checkpoint of
+    ``checkpoints`` (name -> file, its ``.sha256`` sidecar required)."""
     from vnrrt.io import sha256
     from vnrrt.model.checkpoint import load_network
 
     out = {}
-    for name in names:
-        ckpt = paths.checkpoint(name)
+    for name, ckpt in checkpoints.items():
         net, record = load_network(ckpt, name, verify=True)
         out[name] = (net, record, sha256(ckpt))
     return out
+
+
+def predict_rows(cfg: DictConfig, checkpoints: dict[str, Path], instances, rows) -> tuple:
+    """``(maps, meta, timing)`` of the networks of ``checkpoints`` on instances ``rows``:
+    ``{network: (len(rows), S, S) float16}``, what the heatmap file records of each, and its
+    inference time (``predict.batch_size``, ``predict.device``)."""
+    from vnrrt.predict.batch import inputs, predict
+
+    device, maps, meta, timing = pick_device(str(cfg.predict.device)), {}, {}, {}
+    for name, (net, record, sha) in _networks(checkpoints).items():
+        images = inputs(instances, rows, record["render"])
+        maps[name], sec = predict(net, images, int(cfg.predict.batch_size), device)
+        meta[name] = {"target": record["target"], "checkpoint_sha256": sha}
+        timing[name] = {"ms_per_map": 1e3 * sec, "device": device.type, "maps": len(rows)}
+    return maps, meta, timing
 
 
 def run_predict_part(cfg: DictConfig, part: int) -> dict:
@@ -47,7 +65,6 @@ def run_predict_part(cfg: DictConfig, part: int) -> dict:
     from vnrrt.data.heatmaps import part_rows, write_heatmaps
     from vnrrt.data.instances import Instances
     from vnrrt.io import write_json
-    from vnrrt.predict.batch import inputs, predict
 
     paths = section(cfg, "paths", Paths)
     parts = check_parts(cfg.predict.parts, "predict.parts")
@@ -56,20 +73,10 @@ def run_predict_part(cfg: DictConfig, part: int) -> dict:
     torch.set_num_threads(int(cfg.predict.threads))
     instances = Instances(paths.instances)
     rows = np.arange(len(instances))[part_rows(len(instances), part, len(parts))]
-    device, maps, meta, timing = pick_device(str(cfg.predict.device)), {}, {}, {}
-    for name, (net, record, sha) in _networks(list(cfg.predict.networks), paths).items():
-        images = inputs(instances, rows, record["render"])
-        maps[name], sec = predict(net, images, int(cfg.predict.batch_size), device)
-        meta[name] = {"target": record["target"], "checkpoint_sha256": sha}
-        timing[name] = {"ms_per_map": 1e3 * sec, "device": device.type, "maps": len(rows)}
-    write_heatmaps(
-        paths.heatmaps_part(part),
-        instances.keys[rows],
-        maps,
-        networks=meta,
-        part=part,
-        parts=len(parts),
-    )
+    checkpoints = {name: paths.checkpoint(name) for name in cfg.predict.networks}
+    maps, meta, timing = predict_rows(cfg, checkpoints, instances, rows)
+    write_heatmaps(paths.heatmaps_part(part), instances.keys[rows], maps, networks=meta,
+                   part=part, parts=len(parts))  # fmt: skip
     write_json(paths.timing_part(part), timing)
     log.info("part %d/%d: %d instances x %d networks", part, len(parts), len(rows), len(maps))
     return {n: t["ms_per_map"] for n, t in timing.items()}
@@ -90,6 +97,38 @@ def metric_settings(cfg: DictConfig):
     )
 
 
+def split_metrics(maps: np.ndarray, instances, ms) -> dict[str, float]:
+    """The heatmap metrics (settings ``ms``) of ``maps`` ``(N, S, S)`` (one per instance of
+    the file, in order): ``test/<metric>`` over the random instances, ``named/<metric>`` over
+    the named maps."""
+    from vnrrt.predict.batch import heatmap_metrics
+
+    kinds = np.array(instances.kinds)
+    out = {}
+    for prefix, kind in (("test", "random"), ("named", "named")):
+        rows = np.flatnonzero(kinds == kind)
+        metrics = heatmap_metrics(maps[rows], instances, rows, ms)
+        out |= {f"{prefix}/{k}": v for k, v in metrics.items()}
+    return out
+
+
+def network_metrics(maps: dict, instances, ms, targets: dict, timing: list[dict]) -> dict:
+    """``{network: metrics}`` of the heatmaps ``maps`` (``{network: (N, S, S)}``) of the
+    whole instances file: :func:`split_metrics`, the number of random instances, the
+    network's target kind (``targets``) and its inference time, averaged over the ``timing``
+    of the prediction parts."""
+    results = {}
+    n_random = int(np.sum(np.array(instances.kinds) == "random"))
+    for name, heat in maps.items():
+        counts = [t[name]["maps"] for t in timing]
+        ms_per_map = np.average([t[name]["ms_per_map"] for t in timing], weights=counts)
+        results[name] = {**split_metrics(heat, instances, ms), "test_instances": n_random,
+                         "target": targets[name], "ms_per_map": float(ms_per_map),
+                         "device": timing[0][name]["device"]}  # fmt: skip
+        log.info("%s: %s", name, results[name])
+    return results
+
+
 def run_predict_metrics(cfg: DictConfig) -> dict:
     """Stage ``predict_metrics`` (module doc); returns what it wrote: ``{"settings": the
     metrics' settings, "networks": {network: metrics, target, inference time}}``."""
@@ -98,7 +137,6 @@ def run_predict_metrics(cfg: DictConfig) -> dict:
     from vnrrt.data.heatmaps import read_parts
     from vnrrt.data.instances import Instances
     from vnrrt.io import read_json, write_json
-    from vnrrt.predict.batch import heatmap_metrics
     from vnrrt.tracking import LoggerConfig, check_store, tracking_uri
     from vnrrt.viz.evaluation import save_heatmaps
 
@@ -114,32 +152,13 @@ def run_predict_metrics(cfg: DictConfig) -> dict:
             f"heatmap parts in {paths.heatmaps} do not cover the instances of "
             f"{paths.instances} (re-run `dvc repro`)"
         )
-    kinds = np.array(instances.kinds)
-    named, random = np.flatnonzero(kinds == "named"), np.flatnonzero(kinds == "random")
     timing = [read_json(paths.timing_part(k)) for k in parts]
+    targets = {n: m["target"]["kind"] for n, m in files["meta"][0]["networks"].items()}
     ms = metric_settings(cfg)
-    results = {}
-    for name, maps in files["maps"].items():
-        counts = [t[name]["maps"] for t in timing]
-        results[name] = {
-            **{
-                f"test/{k}": v
-                for k, v in heatmap_metrics(maps[random], instances, random, ms).items()
-            },
-            **{
-                f"named/{k}": v
-                for k, v in heatmap_metrics(maps[named], instances, named, ms).items()
-            },
-            "test_instances": len(random),
-            "target": files["meta"][0]["networks"][name]["target"]["kind"],
-            "ms_per_map": float(
-                np.average([t[name]["ms_per_map"] for t in timing], weights=counts)
-            ),
-            "device": timing[0][name]["device"],
-        }
-        log.info("%s: %s", name, results[name])
+    results = network_metrics(files["maps"], instances, ms, targets, timing)
     out = {"settings": dataclasses.asdict(ms), "networks": results}
     write_json(paths.predict_metrics, out)
+    named = np.flatnonzero(np.array(instances.kinds) == "named")
     shown = [instances[int(i)] for i in named]
     save_heatmaps(
         paths.heatmaps_figure,
@@ -158,4 +177,39 @@ def run_predict_metrics(cfg: DictConfig) -> dict:
                  "instances": paths.instances}  # fmt: skip
         trainings = {n: paths.train_metrics(n) for n in results}
         log_predict(logger, str(cfg.scale.name), out, files, trainings, shown)
+    return out
+
+
+UNIFORM = 0.5  # the constant map whose metrics are "a uniform map's" (every pixel above tau 0.5)
+
+
+def run_budget_predict(cfg: DictConfig, steps: int) -> dict:
+    """Stage ``budget_predict@<steps>``: the heatmaps of every instance by the networks of
+    ``predict.networks`` trained for ``steps`` (``paths.budget_training``) ->
+    ``heatmaps/part_0.npz`` of ``paths.budget_heatmaps(steps)``, and their metrics as stage
+    ``predict_metrics`` computes them, beside those of a constant (uniform) map ``uniform``,
+    -> ``paths.budget_predict_metrics(steps)``; returns what it wrote."""
+    import dataclasses
+
+    from vnrrt.data.heatmaps import part_file, write_heatmaps
+    from vnrrt.data.instances import Instances
+    from vnrrt.io import write_json
+
+    paths = section(cfg, "paths", Paths)
+    torch.set_num_threads(int(cfg.predict.threads))
+    instances = Instances(paths.instances)
+    rows = np.arange(len(instances))
+    nets = {n: paths.budget_training(n, steps).checkpoint for n in cfg.predict.networks}
+    maps, meta, timing = predict_rows(cfg, nets, instances, rows)
+    write_heatmaps(part_file(paths.budget_heatmaps(steps), 0), instances.keys, maps,
+                   networks=meta, part=0, parts=1, budget_steps=int(steps))  # fmt: skip
+    ms = metric_settings(cfg)
+    targets = {n: m["target"]["kind"] for n, m in meta.items()}
+    flat = np.full((len(instances), instances.size, instances.size), UNIFORM, np.float16)
+    out = {
+        "settings": dataclasses.asdict(ms),
+        "networks": network_metrics(maps, instances, ms, targets, [timing]),
+        "uniform": split_metrics(flat, instances, ms),
+    }
+    write_json(paths.budget_predict_metrics(steps), out)
     return out

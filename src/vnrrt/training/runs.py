@@ -1,4 +1,7 @@
-"""The MLflow run of a training (stage ``train@<network>``), named ``<network> <scale>``.
+"""The MLflow run of a training (stage ``train@<network>``), named ``<network> <scale>``; a
+training of the budget curve (``budget_train@<network>-<steps>``) is named ``<network> <scale>
+budget <steps>``, tagged ``budget_steps``, has the param ``budget.steps`` and logs no MLflow
+Model (the registry holds the networks the evaluation samples, not the budget curve's).
 
 * **Params**: what determines the weights, flattened (``seed``, ``model.*``, ``train.*``,
   ``trainer.*``) and the network's target under keys common to every network
@@ -32,12 +35,13 @@ INFRASTRUCTURE = ("callbacks.", "train.datamodule.shards_dir", "train.datamodule
 SPLITS = {"train": "training", "val": "validation", "test": "test"}  # split -> input context
 
 
-def run_params(settings: dict, record: dict) -> dict:
+def run_params(settings: dict, record: dict, budget: int | None = None) -> dict:
     """The training's params (module doc) from its ``settings`` (seed, model, train, trainer,
-    callbacks as plain containers) and checkpoint ``record``."""
+    callbacks as plain containers), checkpoint ``record`` and budget-curve steps (or None)."""
     t = record["target"]
     network = {"target": t["kind"], "endpoints": t["endpoints"], "target_radius": t["radius"]}
-    flat = tracking.flat_params({**settings, "network": network})
+    extra = {} if budget is None else {"budget": {"steps": int(budget)}}
+    flat = tracking.flat_params({**settings, "network": network, **extra})
     return {
         k: v
         for k, v in flat.items()
@@ -46,18 +50,19 @@ def run_params(settings: dict, record: dict) -> dict:
 
 
 def start_run(logger_cfg: tracking.LoggerConfig, scale: str, network: str, record: dict,
-              settings: dict, config_text: str):  # fmt: skip
+              settings: dict, config_text: str, budget: int | None = None):  # fmt: skip
     """The run's ``MLFlowLogger`` (experiment per scale, tags, :func:`run_params`, the
-    parameter counts and ``config.yaml``) with the shard datasets logged as inputs."""
+    parameter counts and ``config.yaml``) with the shard datasets logged as inputs;
+    ``budget``: the steps of a budget-curve training (module doc), else None."""
     from hydra.utils import instantiate
 
+    extra = {} if budget is None else {"budget_steps": str(int(budget))}
     uri, _, tags = tracking.open_experiment(
-        logger_cfg, network, scale, fingerprint=record["fingerprint"]
+        logger_cfg, network, scale, fingerprint=record["fingerprint"], **extra
     )
-    logger = instantiate(
-        logger_cfg.lightning, run_name=f"{network} {scale}", tracking_uri=uri, tags=tags
-    )
-    logger.log_hyperparams(run_params(settings, record))
+    name = f"{network} {scale}" + ("" if budget is None else f" budget {int(budget)}")
+    logger = instantiate(logger_cfg.lightning, run_name=name, tracking_uri=uri, tags=tags)
+    logger.log_hyperparams(run_params(settings, record, budget))
     counts = {k: v for k, v in record["describe"].items() if k.startswith("params_")}
     logger.log_metrics({f"network/{k}": float(v) for k, v in counts.items()})
     logger.experiment.log_text(logger.run_id, config_text, "config.yaml")

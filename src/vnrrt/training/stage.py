@@ -1,17 +1,20 @@
-"""Entry point of the ``train@<network>`` stages: build every object from config with
-``hydra.utils.instantiate`` (the network and loss from ``model``, the DataModule and the
-LightningModule factories from ``train``, the callbacks from ``callbacks``, the
+"""Entry points of the ``train@<network>`` stages and of the budget curve's
+``budget_train@<network>-<steps>`` (:mod:`vnrrt.training.budget`): build every object from
+config with ``hydra.utils.instantiate`` (the network and loss from ``model``, the DataModule
+and the LightningModule factories from ``train``, the callbacks from ``callbacks``, the
 ``lightning.Trainer`` from ``trainer``; as lightning-hydra-template does), then call
 :func:`vnrrt.training.train.fit`.
 
-Outputs: ``paths.checkpoint(network)`` (with the record of :func:`make_record`) and its
-sidecar ``.sha256``, ``paths.train_metrics(network)`` and an MLflow run
-(:mod:`vnrrt.training.runs`) holding the network as an MLflow Model (pytorch flavour,
-signature, input example), registered as ``vnrrt-<network>`` with the alias ``@<scale>``.
+Outputs (:class:`vnrrt.paths.TrainFiles`: ``paths.training(network)``, or
+``paths.budget_training(network, steps)``): the checkpoint (with the record of
+:func:`make_record`) and its sidecar ``.sha256``, the metrics JSON and an MLflow run
+(:mod:`vnrrt.training.runs`); a pipeline training's run holds the network as an MLflow Model
+(pytorch flavour, signature, input example), registered as ``vnrrt-<network>`` with the alias
+``@<scale>``.
 
-**Resuming**: Lightning writes ``paths.run_folder(network) / "last.ckpt"`` after every
-epoch. A re-run after a kill resumes from it when it was written with the same settings (its
-record's ``fingerprint``), and says why it restarts otherwise; the folder is removed after a
+**Resuming**: Lightning writes ``<run folder>/last.ckpt`` after every epoch. A re-run after a
+kill resumes from it when it was written with the same settings (its record's
+``fingerprint``), and says why it restarts otherwise; the folder is removed after a
 successful run. Resuming gives the same weights as an uninterrupted run (tested).
 """
 
@@ -28,7 +31,7 @@ from omegaconf import DictConfig, OmegaConf
 
 from vnrrt import tracking
 from vnrrt.config import ConfigError, section
-from vnrrt.paths import Paths
+from vnrrt.paths import Paths, TrainFiles
 
 log = logging.getLogger(__name__)
 LOGGER_CALLBACKS = ("learning_rate_monitor", "prediction_figures")  # need an MLflow logger
@@ -103,15 +106,14 @@ def make_record(network: str, net_config: dict, spec: NetworkSpec, dm: dict, net
     }
 
 
-def resume_from(spec: NetworkSpec, paths: Paths, network: str, record: dict) -> Path | None:
-    """The checkpoint to resume from: ``spec.resume`` if set, else the last checkpoint of an
-    interrupted run with the same settings (module doc), else None."""
+def resume_from(spec: NetworkSpec, last: Path, network: str, record: dict) -> Path | None:
+    """The checkpoint to resume from: ``spec.resume`` if set, else ``last`` (the last
+    checkpoint of an interrupted run) when it has the same settings (module doc), else None."""
     from vnrrt.model.checkpoint import CheckpointError, read_checkpoint
     from vnrrt.model.module import RECORD_KEY
 
     if spec.resume is not None:
         return Path(spec.resume)
-    last = paths.run_folder(network) / "last.ckpt"
     if not last.is_file():
         return None
     try:
@@ -179,7 +181,26 @@ def monitored_fit(logger_cfg: tracking.LoggerConfig, logger, fit_run):
 
 def run_train(cfg: DictConfig, network: str) -> dict:
     """Stage ``train@<network>``: train ``network`` as configured (module doc); returns and
-    writes its metrics. The stage's parameters are read here; below, typed pieces."""
+    writes its metrics."""
+    return train_network(cfg, network, section(cfg, "paths", Paths).training(network))
+
+
+def run_budget_train(cfg: DictConfig, network: str, steps: int) -> dict:
+    """Stage ``budget_train@<network>-<steps>``: ``network`` trained for ``steps`` optimizer
+    steps with a schedule of its own (:func:`vnrrt.training.budget.budget_config`) ->
+    ``paths.budget_training(network, steps)``, resumable as the pipeline's trainings; its
+    metrics add ``budget`` (:func:`budget_record`)."""
+    from vnrrt.training.budget import budget_config
+
+    files = section(cfg, "paths", Paths).budget_training(network, steps)
+    return train_network(budget_config(cfg, steps), network, files, budget=int(steps))
+
+
+def train_network(cfg: DictConfig, network: str, files: TrainFiles,
+                  budget: int | None = None) -> dict:  # fmt: skip
+    """Train ``network`` as ``cfg`` says into ``files`` (module doc); ``budget``: the steps
+    of a budget-curve training (its MLflow run, no MLflow Model). The stage's parameters are
+    read here; below, typed pieces."""
     logger_cfg = section(cfg, "logger", tracking.LoggerConfig)
     uri = tracking.configure(logger_cfg.uri)  # before Lightning (and its MLflow logger) imports
     if logger_cfg.enabled:
@@ -202,60 +223,75 @@ def run_train(cfg: DictConfig, network: str) -> dict:
     net, loss = instantiate(cfg.model.net), instantiate(cfg.model.loss)
     record = make_record(network, settings["model"]["net"], spec, settings["train"]["datamodule"],
                          net, fingerprint(settings, spec, paths))  # fmt: skip
-    make_module = instantiate(cfg.train.module, _partial_=True)
-    module = make_module(net=net, loss=loss, record=record)
-    resume = resume_from(spec, paths, network, record)
+    module = instantiate(cfg.train.module, _partial_=True)(net=net, loss=loss, record=record)
+    resume = resume_from(spec, files.run_folder / "last.ckpt", network, record)
     if resume is not None:
         check_checkpoint(resume, record, module)
     logger, scale = None, str(cfg.scale.name)
     if logger_cfg.enabled:
         from vnrrt.training.runs import start_run
 
-        logger = start_run(logger_cfg, scale, network, record, settings, OmegaConf.to_yaml(cfg))
-    callbacks = build_callbacks(cfg.get("callbacks"), paths.run_folder(network), logger is not None)
+        text = OmegaConf.to_yaml(cfg)
+        logger = start_run(logger_cfg, scale, network, record, settings, text, budget)
+    callbacks = build_callbacks(cfg.get("callbacks"), files.run_folder, logger is not None)
     bar = any(type(c).__name__ == "TQDMProgressBar" for c in callbacks)
     precision = resolve_precision(cfg.trainer.precision, cfg.trainer.accelerator)
-    trainer = instantiate(
-        cfg.trainer,
-        callbacks=callbacks,
-        logger=logger or False,
-        precision=precision,
-        enable_progress_bar=bar,
-        _convert_="all",
-    )
-    out, metrics_file = paths.checkpoint(network), paths.train_metrics(network)
+    trainer = instantiate(cfg.trainer, callbacks=callbacks, logger=logger or False,
+                          precision=precision, enable_progress_bar=bar,
+                          _convert_="all")  # fmt: skip
     batch = int(cfg.train.datamodule.batch_size)
     metrics = monitored_fit(logger_cfg, logger if trainer.is_global_zero else None,
-                            lambda: fit(module, datamodule, trainer, out, metrics_file, batch,
-                                        resume))  # fmt: skip
+                            lambda: fit(module, datamodule, trainer, files.checkpoint,
+                                        files.metrics, batch, resume,
+                                        with_val=budget is not None))  # fmt: skip
+    if budget is not None:
+        metrics["budget"] = budget_record(trainer, budget)
     if trainer.is_global_zero:
         if logger is not None:
-            metrics |= finish_run(logger_cfg, scale, network, out, logger, datamodule, metrics)
+            metrics |= finish_run(logger_cfg, scale, network, files.checkpoint, logger,
+                                  datamodule, metrics, as_model=budget is None)  # fmt: skip
         from vnrrt.io import write_json
         from vnrrt.model.checkpoint import write_checksum
 
-        metrics["checkpoint_sha256"] = write_checksum(out)
+        metrics["checkpoint_sha256"] = write_checksum(files.checkpoint)
         metrics["threads"] = threads
         metrics["batch_size"] = batch
         metrics["network"] = record["describe"]  # architecture, initialisation, parameters
         metrics["target"] = record["target"]
-        write_json(metrics_file, metrics)
-        shutil.rmtree(paths.run_folder(network), ignore_errors=True)
+        write_json(files.metrics, metrics)
+        shutil.rmtree(files.run_folder, ignore_errors=True)
     return metrics
 
 
 def finish_run(logger_cfg: tracking.LoggerConfig, scale: str, network: str, checkpoint: Path,
-               logger, datamodule, metrics: dict) -> dict:  # fmt: skip
-    """Tag the run with the checkpoint's hash and, with ``logger.log_model``, log and register
-    the network (:func:`vnrrt.training.runs.log_model`); returns what the training metrics
-    file records of the run."""
+               logger, datamodule, metrics: dict, as_model: bool = True) -> dict:  # fmt: skip
+    """Tag the run with the checkpoint's hash and, with ``as_model`` and ``logger.log_model``,
+    log and register the network (:func:`vnrrt.training.runs.log_model`); returns what the
+    training metrics file records of the run."""
     from vnrrt.io import sha256
     from vnrrt.training.runs import log_model
 
     logger.experiment.set_tag(logger.run_id, "checkpoint_sha256", sha256(checkpoint))
     out = {"mlflow_run_id": logger.run_id}
-    if logger_cfg.log_model:
+    if as_model and logger_cfg.log_model:
         example = datamodule.datasets["val"][0]["image"][None].numpy()  # (1, 3, S, S) float32
         tested = {k: v for k, v in metrics.items() if k.startswith("test/")}
         out |= log_model(logger_cfg, scale, network, checkpoint, logger, example, tested)
     return out
+
+
+def budget_record(trainer, steps: int) -> dict:
+    """What a budget training adds to its metrics: its steps, epochs and batches per epoch,
+    and how far its learning-rate schedule ran (``schedule_steps`` of ``schedule_total``:
+    equal for a schedule of its own run to its end); ``ValueError`` unless it ran exactly
+    ``steps`` steps."""
+    from vnrrt.training.budget import check_steps
+
+    batches = int(trainer.limit_train_batches)
+    check_steps(int(trainer.global_step), steps, batches)
+    configs = trainer.lr_scheduler_configs
+    scheduler = configs[0].scheduler if configs else None
+    total = getattr(scheduler, "total_steps", None)
+    return {"steps": steps, "epochs": int(trainer.current_epoch), "batches_per_epoch": batches,
+            "schedule_steps": None if scheduler is None else int(scheduler.last_epoch),
+            "schedule_total": None if total is None else int(total)}  # fmt: skip

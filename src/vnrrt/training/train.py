@@ -53,13 +53,25 @@ def save_final(trainer: L.Trainer, out: Path) -> None:
     os.replace(tmp, out)
 
 
+def validation_metrics(trainer: L.Trainer) -> dict[str, float]:
+    """The last validation's metrics (``val/...``) of a fitted trainer; read them before
+    ``trainer.test``, which replaces the trainer's ``callback_metrics``."""
+    return {k: float(v) for k, v in trainer.callback_metrics.items() if k.startswith("val/")}
+
+
 def summary(
-    trainer: L.Trainer, tested: dict, seconds: float, batch_size: int, first_step: int = 0
+    trainer: L.Trainer,
+    tested: dict,
+    seconds: float,
+    batch_size: int,
+    first_step: int = 0,
+    val: dict | None = None,
 ) -> dict:
-    """Metrics of a run: final val metrics, test metrics, steps, time, throughput.
-    ``first_step``: the step a resumed run started from; ``fit_seconds`` and the throughput
-    are those of this run's steps only."""
-    val = {k: float(v) for k, v in trainer.callback_metrics.items() if k.startswith("val/")}
+    """Metrics of a run: the final validation's metrics (``val``: :func:`validation_metrics`
+    read after fitting; None: those left in the trainer, none after a test), test metrics,
+    steps, time, throughput. ``first_step``: the step a resumed run started from;
+    ``fit_seconds`` and the throughput are those of this run's steps only."""
+    val = validation_metrics(trainer) if val is None else val
     per_step = batch_size * trainer.world_size
     return {
         **val,
@@ -90,17 +102,22 @@ def fit(
     metrics_file: Path,
     batch_size: int,
     resume: Path | None = None,
+    with_val: bool = False,
 ) -> dict:
     """Train ``module`` (from ``resume``, a Lightning checkpoint, if given), write the final
-    checkpoint to ``out``, test it and write the metrics to ``metrics_file``; returns them."""
+    checkpoint to ``out``, test it and write the metrics to ``metrics_file``; returns them.
+    ``with_val``: with the final validation's metrics (``val/...``; the budget curve's
+    trainings: its report, the target variants' selection). The pipeline's trainings leave
+    them out: their metrics files are ``dvc metrics show``'s rows."""
     first_step = resumed_step(resume)  # before the run overwrites its last.ckpt
     start = time.perf_counter()
     trainer.fit(module, datamodule=datamodule, ckpt_path=None if resume is None else str(resume))
     seconds = time.perf_counter() - start
+    val = validation_metrics(trainer) if with_val else {}  # before the test replaces them
     out.parent.mkdir(parents=True, exist_ok=True)
     save_final(trainer, out)
     tested = trainer.test(module, datamodule=datamodule, verbose=False)[0]
-    metrics = summary(trainer, tested, seconds, batch_size, first_step)
+    metrics = summary(trainer, tested, seconds, batch_size, first_step, val)
     if trainer.is_global_zero:
         write_json(metrics_file, metrics)
         log.info("%s: %s", out.stem, {k: round(v, 4) for k, v in metrics.items()})

@@ -1,0 +1,59 @@
+"""What the budget curve's trials run, per budget (stage ``budget_trials@<steps>``): RRT* and
+every learned planner of ``eval.planners`` sampling its ``eval.sources`` network, M-VNRRT* at
+the claims' threshold ``planner.tau`` only, not informed, on the random instances of the
+instances file (the comparable map set), every stop rule of the protocol with its trial
+counts (``eval.random_initial``, ``eval.random_optimal``, ``eval.any_angle``), its obstacle
+rule (``eval.zero_obstacles``) and its paired seeds, so that a budget's configurations are
+compared on the same trials, and the budgets on the same instances and seeds.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from vnrrt.evaluation.config import Configurations, EvalConfig
+from vnrrt.evaluation.keys import ConfigKey
+from vnrrt.evaluation.protocol import TrialJob, configurations, trial_counts, trial_jobs
+
+BASELINE = ConfigKey("rrt_star")
+CONTROL = "nrrt_star"  # the planner the VNRRT* ratio is taken against
+
+
+@dataclass(frozen=True)
+class BudgetTrials:
+    """The ``eval`` keys the budget trials read (module doc)."""
+
+    planners: list[str]
+    sources: dict[str, str]
+    random_initial: int
+    random_optimal: int
+    any_angle: bool
+    endpoint_radius: float
+    zero_obstacles: bool
+
+    def keys(self, tau: float) -> list[ConfigKey]:
+        """The configurations, in the protocol's order (``rrt_star``, ``nrrt_star``,
+        ``vnrrt_star``, ``m_vnrrt_star@<tau>`` as configured)."""
+        ev = Configurations(list(self.planners), dict(self.sources), informed=False,
+                            endpoint_radius=self.endpoint_radius,
+                            zero_obstacles=self.zero_obstacles)  # fmt: skip
+        return configurations(ev, [tau], tau)
+
+    def counts(self) -> dict[tuple[str, str], int]:
+        """Trials per random instance and stop rule (none on the named maps)."""
+        ev = EvalConfig(named_initial=0, named_optimal=0, random_initial=self.random_initial,
+                        random_optimal=self.random_optimal, any_angle=self.any_angle)  # fmt: skip
+        return trial_counts(ev)
+
+    def jobs(self, kinds: list[str], tau: float) -> list[TrialJob]:
+        """Every job in canonical order; ``kinds[i]``: instance ``i``'s kind (``named`` or
+        ``random``) in the instances file."""
+        return trial_jobs(kinds, self.keys(tau), self.counts())
+
+    def stops(self) -> list[str]:
+        """The stop rules that run, in the protocol's order."""
+        return list(dict.fromkeys(stop for (kind, stop), n in self.counts().items() if n))
+
+    def ratio_keys(self, tau: float) -> list[ConfigKey]:
+        """The planners compared with NRRT* (:data:`CONTROL`): VNRRT* and M-VNRRT*."""
+        return [k for k in self.keys(tau) if k.planner not in (BASELINE.planner, CONTROL)]
