@@ -27,6 +27,7 @@ def run(cmd: list[str], cwd: Path) -> str:
     return proc.stdout + proc.stderr
 
 
+@pytest.mark.slow
 def test_ddp_trains_on_two_cpu_processes(small_data, tmp_path):
     cfg = compose([*SMALL, *paths(small_data, tmp_path), *QUICK, "trainer=ddp",
                    "trainer.accelerator=cpu", "trainer.devices=2"])  # fmt: skip

@@ -56,7 +56,7 @@ def section(cfg: DictConfig | dict, key: str, schema: type[T]) -> T:
     naming the offending ``key.subkey`` (defaults of the dataclasses serve library callers;
     a composed config must give every key).
     """
-    from omegaconf import OmegaConf
+    from omegaconf import DictConfig, OmegaConf
     from omegaconf.errors import OmegaConfBaseException
 
     node = cfg.get(key) if isinstance(cfg, Mapping) else None
@@ -71,7 +71,9 @@ def section(cfg: DictConfig | dict, key: str, schema: type[T]) -> T:
     missing = [n for n in names if n not in node]
     if missing:
         raise ConfigError(f"config section {key!r} lacks {missing} (conf/ gives every key)")
-    try:
+    try:  # interpolations resolved against the whole config first (``${scale.name}``)
+        if isinstance(node, DictConfig):
+            node = OmegaConf.to_container(node, resolve=True)
         merged = OmegaConf.merge(OmegaConf.structured(schema), node)
         obj = OmegaConf.to_object(merged)
     except OmegaConfBaseException as err:

@@ -42,15 +42,14 @@ class Model:
         return self.record.get("render", DEFAULT_RENDER)
 
 
-def _from_mlflow(uri: str) -> Model:
+def _from_mlflow(uri: str, store: str) -> Model:
+    """The model at ``uri`` (``runs:/``, or ``models:/<name>/<version>``) of tracking store
+    ``store``."""
     import mlflow
     import mlflow.pytorch
 
-    from vnrrt import tracking
     from vnrrt.model.checkpoint import CheckpointError
 
-    store = tracking.tracking_uri()
-    tracking.check_store(store)
     mlflow.set_tracking_uri(store)
     try:
         net = mlflow.pytorch.load_model(uri, map_location="cpu")
@@ -67,10 +66,31 @@ def _from_mlflow(uri: str) -> Model:
     return Model(net.eval(), record)
 
 
+def _mlflow_source(uri: str) -> tuple[str, str]:
+    """``(uri, store)``: an MLflow model URI with a registry alias resolved to the version it
+    names now (``models:/vnrrt-vertexnet@quick`` -> ``models:/vnrrt-vertexnet/3``), and the
+    tracking store it is read from; the two together name one model, so that a cache keyed by
+    them never returns another store's version 1 or an alias's previous version."""
+    from vnrrt import tracking
+    from vnrrt.model.checkpoint import CheckpointError
+
+    store = tracking.tracking_uri()
+    tracking.check_store(store)
+    name, at, alias = uri.removeprefix("models:/").partition("@")
+    if not (uri.startswith("models:/") and at):
+        return uri, store
+    try:
+        version = tracking.open_store(store).get_model_version_by_alias(name, alias).version
+    except Exception as err:  # MlflowException: no such model or alias
+        text = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
+        raise CheckpointError(f"model {uri} cannot be loaded from {store}: {text}") from None
+    return f"models:/{name}/{version}", store
+
+
 @functools.lru_cache(maxsize=8)
-def _cached(source: str, mtime: float) -> Model:
-    if source.startswith(("runs:/", "models:/")):
-        return _from_mlflow(source)
+def _cached(source: str, mtime: float, store: str | None = None) -> Model:
+    if store is not None:
+        return _from_mlflow(source, store)
     from vnrrt.model.checkpoint import load_network
 
     net, record = load_network(source)
@@ -84,7 +104,9 @@ def load_model(source: str | Path | Model) -> Model:
         return source
     text = str(source)
     if text.startswith(("runs:/", "models:/")):
-        return _cached(text, 0.0)
+        uri, store = _mlflow_source(text)
+        model = _cached(uri, 0.0, store)
+        return model if uri == text else Model(model.net, {**model.record, "source": text})
     path = Path(text)
     if not path.is_file():
         from vnrrt.model.checkpoint import CheckpointError
