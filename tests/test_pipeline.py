@@ -313,7 +313,7 @@ def test_metrics_and_plots_read_well(workdir):
     import vl_convert
 
     shown = run(["dvc", "metrics", "show", "reports/metrics/headline.json"], workdir)
-    assert max(len(line) for line in shown.splitlines()) < 300
+    assert len(shown.splitlines()) <= 4  # a header and one row (of about 20 columns)
     every = run(["dvc", "metrics", "show"], workdir)
     assert "reports/metrics/train_vertexnet.json" in every and "headline.json" in every
     spec_json = run(["dvc", "plots", "show", "--json"], workdir)
