@@ -41,6 +41,7 @@ def recall_on(net, batch, mask: str = "interior") -> float:
     return float(VertexRecall(radius=1.0, tau=0.5, mask=mask)(probs, **{mask: batch[mask]}))
 
 
+@pytest.mark.slow
 def test_overfitting_a_handful_of_instances_drives_interior_recall_up(small_data, tmp_path):
     """Four instances learnt by heart: the vertices between start and goal are found, not
     only the start and goal (whose disks are drawn in the input)."""
