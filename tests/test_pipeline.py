@@ -548,7 +548,7 @@ def test_predict_and_trial_parts_as_multirun_jobs_write_the_stage_files(workdir,
         "-m",
         "vnrrt.multirun",
         "-m",
-        "scale=smoke",
+        *SMOKE,  # the workspace's values (as committed: the session's)
         "seed=1",
         "workers=1",
         "+part=0,1",
