@@ -548,8 +548,8 @@ def test_predict_and_trial_parts_as_multirun_jobs_write_the_stage_files(workdir,
         "-m",
         "vnrrt.multirun",
         "-m",
-        *SMOKE,  # the workspace's values (as committed: the session's)
-        "seed=1",
+        *SMOKE,  # the workspace's values (as committed: the session's, at its seed)
+        f"seed={yaml.safe_load((workdir / 'params.yaml').read_text())['seed']}",
         "workers=1",
         "+part=0,1",
     ]
