@@ -70,6 +70,7 @@ def assert_same_shards(work: Path, expected: dict[int, bytes]) -> None:
         assert shard_file(work / "data/smoke/shards", s).read_bytes() == data, f"shard {s}"
 
 
+@pytest.mark.slow
 def test_joblib_multirun_writes_the_stage_shards_and_dvc_commit_makes_them_current(
     scratch, expected
 ):

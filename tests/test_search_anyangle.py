@@ -162,7 +162,7 @@ small_maps = st.tuples(
 )
 
 
-@settings(max_examples=100)
+@settings(max_examples=50)
 @given(small_maps, st.data())
 def test_length_equals_brute_force(params, data):
     seed, h, w, density = params
