@@ -20,7 +20,7 @@ $(STAMP): pyproject.toml requirements/constraints.txt
 setup: $(STAMP)  ## create .venv and install the pinned environment
 
 test: $(STAMP)  ## run the default test suite (excludes tests marked slow)
-	$(BIN)/python -m pytest -q -n 3 --dist loadfile
+	$(BIN)/python -m pytest -q -n 2 --dist loadfile
 
 test-all: $(STAMP)  ## run every test, slow ones included
 	$(BIN)/python -m pytest -q -m ''
