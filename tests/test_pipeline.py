@@ -66,6 +66,12 @@ def _env(cwd: Path, **env_vars: str) -> dict[str, str]:
     return env | env_vars
 
 
+def seed_override(work: Path) -> str:
+    """``seed=<n>``: the seed of the workspace's ``params.yaml`` (the session's, unless a test
+    changed it), for a command that must compose the workspace's own values."""
+    return f"seed={yaml.safe_load((work / 'params.yaml').read_text())['seed']}"
+
+
 def run(cmd: list[str], cwd: Path, ok: bool = True, **env_vars: str) -> str:
     env = _env(cwd, **env_vars)
     proc = subprocess.run(cmd, cwd=cwd, env=env, capture_output=True, text=True, check=False)
@@ -480,8 +486,7 @@ def test_an_ablation_would_rerun_only_the_evaluation(workdir):
     evaluation stages, nothing else (``dvc repro --dry``: nothing runs)."""
     params = workdir / "params.yaml"
     session = params.read_text()
-    seed = yaml.safe_load(session)["seed"]
-    params.write_text(dump(compose(["scale=smoke", f"seed={seed}"])))
+    params.write_text(dump(compose(["scale=smoke", seed_override(workdir)])))
     try:
         out = run(["dvc", "repro", "--dry"], workdir)
     finally:
@@ -515,9 +520,10 @@ def test_an_ablation_reruns_only_the_evaluation_and_every_output_names_its_value
     other.mkdir(parents=True, exist_ok=True)
     (other / "shard_7.npz").write_bytes(b"another scale's shard")
     (workdir / SHARDS / "shard_1.npz.tmp-999999").write_bytes(b"stray")
-    seed = yaml.safe_load((workdir / "params.yaml").read_text())["seed"]
     sets = [x for k, v in ABLATION.items() for x in ("-S", f"{k}={v}")]
-    out = run(["dvc", "exp", "run", "-S", "scale=smoke", "-S", f"seed={seed}", *sets], workdir)
+    out = run(
+        ["dvc", "exp", "run", "-S", "scale=smoke", "-S", seed_override(workdir), *sets], workdir
+    )
     ran = sorted(line.split("'")[1] for line in out.splitlines() if "Running stage" in line)
     assert ran == EVALUATION_STAGES, out
     check_names_its_values(workdir, 0.02, [0.4, 0.8], 0.45, 0.8, False,
@@ -549,7 +555,7 @@ def test_predict_and_trial_parts_as_multirun_jobs_write_the_stage_files(workdir,
         "vnrrt.multirun",
         "-m",
         *SMOKE,  # the workspace's values (as committed: the session's, at its seed)
-        f"seed={yaml.safe_load((workdir / 'params.yaml').read_text())['seed']}",
+        seed_override(workdir),
         "workers=1",
         "+part=0,1",
     ]
@@ -700,8 +706,9 @@ def test_the_budget_stages_reproduce_the_training_of_their_steps(workdir):
     _back_to_the_commit(workdir)
     client = MlflowClient(f"sqlite:///{workdir / 'mlflow.db'}")
     registered = len(client.search_model_versions("name='vnrrt-vertexnet'"))
-    seed = [f"seed={yaml.safe_load((workdir / 'params.yaml').read_text())['seed']}"]
-    (workdir / "params.yaml").write_text(dump(compose([*SMOKE, *seed, *ONE_BUDGET])))
+    (workdir / "params.yaml").write_text(
+        dump(compose([*SMOKE, seed_override(workdir), *ONE_BUDGET]))
+    )
     out = run(["dvc", "repro"], workdir)
     ran = {line.split("'")[1].split("@")[0] for line in out.splitlines() if "Running" in line}
     assert ran == {"validate", *BUDGET_STAGES}, out
