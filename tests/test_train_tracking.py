@@ -4,6 +4,7 @@ services: an unreachable server refused at once, a locked SQLite store waited fo
 killed stage (and only those) closed at the next start."""
 
 import http.server
+import importlib.metadata
 import os
 import shutil
 import socket
@@ -157,6 +158,19 @@ def test_a_training_run_is_recorded_in_mlflow(small_data, tmp_path, monkeypatch)
     note = tags["mlflow.note.content"]  # the run's description links its version
     assert "[vnrrt-vertexnet/1](#/models/vnrrt-vertexnet/versions/1)" in note and "@smoke" in note
     mlflow.set_tracking_uri(f"sqlite:///{tmp_path}/mlflow.db")
+    # its pip requirements: what loading it needs, pinned to this environment's versions
+    reqs = (
+        Path(
+            mlflow.artifacts.download_artifacts(
+                f"runs:/{run.info.run_id}/vertexnet/requirements.txt"
+            )
+        )
+        .read_text()
+        .split()
+    )
+    installed = {n: importlib.metadata.version(n).split("+")[0] for n in ("torch", "mlflow")}
+    assert {f"{n}=={v}" for n, v in installed.items()} <= set(reqs)
+    assert {r.split("==")[0] for r in reqs} == {"mlflow", "cloudpickle", "numpy", "torch", "vnrrt"}
     model = mlflow.pytorch.load_model(f"runs:/{run.info.run_id}/vertexnet")
     from vnrrt.data.reader import Shard
 

@@ -2,7 +2,7 @@
 
 A checkpoint is Lightning's file plus a ``"vnrrt"`` record (:func:`vnrrt.train.make_record`):
 the network's config, its target, the input rendering and a sha256 of the record and the
-weights (:func:`vnrrt.model.module.record_digest`, written when the file is saved). A
+weights (:func:`vnrrt.model.record.record_digest`, written when the file is saved). A
 checkpoint is only ever used from an explicit path (config or DVC stage), never found by
 globbing.
 
@@ -26,7 +26,7 @@ import torch
 from torch import nn
 
 from vnrrt.data.targets import TARGETS
-from vnrrt.model.module import DIGEST_KEY, RECORD_KEY, record_digest
+from vnrrt.model.record import DIGEST_KEY, RECORD_KEY, record_digest
 from vnrrt.model.resnet import LAYERS
 from vnrrt.model.vertexnet import VertexNet
 

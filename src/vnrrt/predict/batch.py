@@ -16,7 +16,6 @@ import torch
 
 from vnrrt.data.targets import label_masks
 from vnrrt.maps.render import render_instance
-from vnrrt.model.metrics import metric_collection
 
 
 def inputs(instances, rows, render: dict) -> np.ndarray:
@@ -70,6 +69,8 @@ def heatmap_metrics(maps: np.ndarray, instances, rows, ms: MetricSettings) -> di
     """Heatmap metrics (:func:`vnrrt.model.metrics.heatmap_metric_set` with the settings
     ``ms``) of ``maps`` ``(N, S, S)`` against the A* paths and vertices of instances
     ``rows``."""
+    from vnrrt.model.metrics import metric_collection  # torchmetrics: seconds to import
+
     metrics = metric_collection(
         ms.radius, ms.tau, ms.ap_radius, ms.endpoint_radius, ms.taus, with_target=False
     )

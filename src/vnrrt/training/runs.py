@@ -17,7 +17,9 @@ Model (the registry holds the networks the evaluation samples, not the budget cu
 * **The model**: the network as an MLflow Model named after it (``runs:/<run id>/<network>``)
   with its test metrics, registered as ``<registry_prefix><network>`` with a description,
   tags (scale, target, run, checkpoint hash, commit) and the alias ``@<scale>``
-  (``models:/vnrrt-vertexnet@quick``): the version that scale trained last.
+  (``models:/vnrrt-vertexnet@quick``): the version that scale trained last. Its pip
+  requirements are :data:`MODEL_PACKAGES` at their installed versions (MLflow's own inference
+  re-imports the model in a subprocess: 15 s a training).
 """
 
 from __future__ import annotations
@@ -33,6 +35,28 @@ INFRASTRUCTURE = ("callbacks.", "train.datamodule.shards_dir", "train.datamodule
                   "train.datamodule.num_workers", "train.datamodule.pin_memory",
                   "trainer.default_root_dir", "trainer.log_every_n_steps")  # fmt: skip
 SPLITS = {"train": "training", "val": "validation", "test": "test"}  # split -> input context
+# what loading the pickled network needs (vnrrt brings the rest of its own dependencies)
+MODEL_PACKAGES = ("mlflow", "cloudpickle", "numpy", "torch", "vnrrt")
+
+
+def model_requirements() -> list[str]:
+    """The logged model's pip requirements: each of :data:`MODEL_PACKAGES` pinned to its
+    installed version, without a local label (``torch==2.13.0`` for ``2.13.0+cpu``, as
+    MLflow writes it); vnrrt run from a source tree without an install: its ``__version__``."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    import vnrrt
+
+    def pinned(name: str) -> str:
+        try:
+            v = version(name)
+        except PackageNotFoundError:
+            if name != "vnrrt":
+                raise
+            v = vnrrt.__version__
+        return f"{name}=={v.split('+')[0]}"
+
+    return [pinned(name) for name in MODEL_PACKAGES]
 
 
 def run_params(settings: dict, record: dict, budget: int | None = None) -> dict:
@@ -128,6 +152,7 @@ def log_model(logger_cfg: tracking.LoggerConfig, scale: str, network: str, check
             input_example=example,
             registered_model_name=prefix + network if prefix else None,
             serialization_format="pickle",
+            pip_requirements=model_requirements(),
             # how to draw its input image, and what it predicts (checked by vnrrt.predict)
             metadata={"render": dict(record["render"]), "target": dict(record["target"])},
             tags={"scale": scale, "target": record["target"]["kind"]},

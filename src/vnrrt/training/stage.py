@@ -110,7 +110,7 @@ def resume_from(spec: NetworkSpec, last: Path, network: str, record: dict) -> Pa
     """The checkpoint to resume from: ``spec.resume`` if set, else ``last`` (the last
     checkpoint of an interrupted run) when it has the same settings (module doc), else None."""
     from vnrrt.model.checkpoint import CheckpointError, read_checkpoint
-    from vnrrt.model.module import RECORD_KEY
+    from vnrrt.model.record import RECORD_KEY
 
     if spec.resume is not None:
         return Path(spec.resume)
