@@ -25,7 +25,7 @@ import numpy as np
 
 from vnrrt.grid import GridError, as_occupancy, as_point
 from vnrrt.planners import core, run
-from vnrrt.planners.collision import segment_free
+from vnrrt.planners.collision import points_free, segment_free
 from vnrrt.planners.config import PLANNERS, PlannerConfig
 from vnrrt.planners.reference import reference_length as compute_reference
 from vnrrt.planners.result import PlanResult
@@ -116,6 +116,18 @@ def _endpoint(occ: np.ndarray, point, name: str) -> tuple[float, float]:
     raise GridError(f"{name} {(x, y)} touches an obstacle cell or the map border")
 
 
+def _endpoints(occ: np.ndarray, start, goal) -> tuple[tuple[float, float], tuple[float, float]]:
+    """:func:`_endpoint` of both points; valid ones checked in one compiled call."""
+    try:
+        (sx, sy), (gx, gy) = start, goal
+        sx, sy, gx, gy = float(sx), float(sy), float(gx), float(gy)
+    except (TypeError, ValueError):
+        sx = math.nan
+    if math.isfinite(sx + sy + gx + gy) and points_free(occ, sx, sy, gx, gy):
+        return (sx, sy), (gx, gy)
+    return _endpoint(occ, start, "start"), _endpoint(occ, goal, "goal")  # one of them raises
+
+
 def _seed(seed) -> None:
     if type(seed) is int and seed >= 0:  # the common case, checked fast
         return
@@ -167,10 +179,14 @@ class Planner:
         else:
             check_sampler(sampler, planner, self.occ.shape, self.config)
         self.sampler = sampler
+
+    @functools.cached_property
+    def _work(self) -> run.Workspace:
+        """The tree's arrays, reused by every search of this planner (made by the first)."""
         cfg = self.config
         budget = run.Budget(cfg.max_iterations, cfg.max_seconds, cfg.trace_capacity)
         bucket = max(min(cfg.eta, max(self.occ.shape)) / 2, 1.0)  # an unlimited step: the map
-        self._work = run.Workspace(self.occ.shape, bucket, budget)
+        return run.Workspace(self.occ.shape, bucket, budget)
 
     @functools.cached_property
     def draws(self) -> core.Draws:
@@ -221,8 +237,7 @@ class Planner:
             NoPathError: the A* reference is needed and start and goal are not connected.
             ValueError: unknown stop rule, bad reference length or seed.
         """
-        start = _endpoint(self.occ, start, "start")
-        goal = _endpoint(self.occ, goal, "goal")
+        start, goal = _endpoints(self.occ, start, goal)
         if stop not in ("initial", "optimal"):
             raise ValueError(f"unknown stop rule {stop!r}; use 'initial' or 'optimal'")
         _seed(seed)
@@ -318,4 +333,5 @@ def warmup() -> None:
             query = run.Query((1.5, 3.5), (6.5, 3.5), 0.0, (), False, None, 0.0, False)
             p._run(query, 0)
     core.straight_cost(occ, 0.5, 0.5, 1.5, 1.5)
+    points_free(occ, 0.5, 0.5, 1.5, 1.5)
     log.debug("planner kernels compiled")

@@ -124,31 +124,31 @@ def straight_result(planner: str, query: Query, d: float, found: float) -> PlanR
     """The result of a run answered after ``found`` seconds by the free straight segment of
     length ``d``: the tree is the root and the goal joined to it (one segment test). The
     cost is ``d``, equal to the polyline length of the path (both are libm's ``hypot``)."""
-    path = np.array((*query.start, *query.goal)).reshape(2, 2)
+    path = np.array((query.start, query.goal))
     extra = tuple(Milestone(b, found, 0) if d <= b else Milestone(b) for b in query.bounds)
-    return PlanResult(
-        planner=planner,
-        success=True,
-        stop_reason="solved",
-        path=path,
-        cost=d,
-        iterations=0,
-        tree_size=2,
-        collision_checks=1,
-        time_to_first=found,
-        time_to_stop=found,
-        first_cost=d,
-        first_iteration=0,
-        trace_iterations=np.zeros(1, np.int64),
-        trace_costs=np.array([d]),
-        reference_length=query.reference_length,
-        target_cost=query.target,
-        milestones=extra,
-        fallback_uniform=query.fallback_uniform,
-        setup_time=query.setup_time,
-        tree_points=path.copy() if query.keep_tree else None,
-        tree_parents=np.array([-1, 0], np.int64) if query.keep_tree else None,
-    )
+    return PlanResult.of({
+        "planner": planner,
+        "success": True,
+        "stop_reason": "solved",
+        "path": path,
+        "cost": d,
+        "iterations": 0,
+        "tree_size": 2,
+        "collision_checks": 1,
+        "time_to_first": found,
+        "time_to_stop": found,
+        "first_cost": d,
+        "first_iteration": 0,
+        "trace_iterations": np.zeros(1, np.int64),
+        "trace_costs": np.array([d]),
+        "reference_length": query.reference_length,
+        "target_cost": query.target,
+        "milestones": extra,
+        "fallback_uniform": query.fallback_uniform,
+        "setup_time": query.setup_time,
+        "tree_points": path.copy() if query.keep_tree else None,
+        "tree_parents": np.array([-1, 0], np.int64) if query.keep_tree else None,
+    })  # fmt: skip
 
 
 def search(
@@ -240,26 +240,26 @@ def result(
     if last:
         trace_it[k], trace_cost[k] = c.iters[0], tree.cost[g]
     first_time, first_iter = reached[math.inf]
-    return PlanResult(
-        planner=planner,
-        success=reason == "solved",
-        stop_reason=reason,
-        path=path,
-        cost=polyline_length(path) if g >= 0 else math.inf,
-        iterations=int(c.iters[0]),
-        tree_size=n,
-        collision_checks=int(c.checks[0]),
-        time_to_first=first_time,
-        time_to_stop=elapsed,
-        first_cost=float(trace_cost[0]) if k else math.inf,
-        first_iteration=first_iter,
-        trace_iterations=trace_it,
-        trace_costs=trace_cost,
-        reference_length=query.reference_length,
-        target_cost=query.target,
-        milestones=tuple(Milestone(b, *reached[b]) for b in query.bounds),
-        fallback_uniform=query.fallback_uniform,
-        setup_time=query.setup_time,
-        tree_points=tree.pts[:n].copy() if query.keep_tree else None,
-        tree_parents=tree.links[:n, nodes.PARENT].copy() if query.keep_tree else None,
-    )
+    return PlanResult.of({
+        "planner": planner,
+        "success": reason == "solved",
+        "stop_reason": reason,
+        "path": path,
+        "cost": polyline_length(path) if g >= 0 else math.inf,
+        "iterations": int(c.iters[0]),
+        "tree_size": n,
+        "collision_checks": int(c.checks[0]),
+        "time_to_first": first_time,
+        "time_to_stop": elapsed,
+        "first_cost": float(trace_cost[0]) if k else math.inf,
+        "first_iteration": first_iter,
+        "trace_iterations": trace_it,
+        "trace_costs": trace_cost,
+        "reference_length": query.reference_length,
+        "target_cost": query.target,
+        "milestones": tuple(Milestone(b, *reached[b]) for b in query.bounds),
+        "fallback_uniform": query.fallback_uniform,
+        "setup_time": query.setup_time,
+        "tree_points": tree.pts[:n].copy() if query.keep_tree else None,
+        "tree_parents": tree.links[:n, nodes.PARENT].copy() if query.keep_tree else None,
+    })  # fmt: skip
