@@ -1,5 +1,7 @@
 """The training config groups compose, instantiate, and pick the right network per scale."""
 
+import logging
+
 import lightning as L
 import pytest
 from hydra.utils import instantiate
@@ -9,7 +11,7 @@ from vnrrt.config import CONF_DIR, compose
 from vnrrt.data.datamodule import ShardDataModule
 from vnrrt.model.module import VertexNetModule
 from vnrrt.training.callbacks import LogProgress, progress_callback
-from vnrrt.training.train import resolve_precision
+from vnrrt.training.train import cpu_bf16_flags, resolve_precision
 
 TRAINERS = sorted(p.stem for p in (CONF_DIR / "trainer").glob("*.yaml"))
 
@@ -59,3 +61,25 @@ def test_precision_is_bf16_on_gpu_and_32_on_cpu():
 
 def test_non_tty_logs_get_log_lines_instead_of_a_bar():
     assert isinstance(progress_callback(10), LogProgress)  # pytest captures stderr: no TTY
+
+
+def test_bf16_on_a_cpu_without_native_bf16_is_kept_and_warned_about(tmp_path, caplog):
+    """conf/ decides the precision; a bf16 mode on a CPU whose flags lack avx512_bf16 and
+    amx_bf16 is used as asked, with a warning naming the fp32 override."""
+    avx2, native = tmp_path / "avx2", tmp_path / "native"
+    avx2.write_text("processor\t: 0\nflags\t\t: fpu sse2 avx avx2 fma\n\nflags\t: fpu avx2\n")
+    native.write_text("processor\t: 0\nflags\t\t: fpu avx2 avx512f avx512_bf16 amx_bf16\n")
+    with caplog.at_level(logging.WARNING, logger="vnrrt.training.train"):
+        assert resolve_precision("bf16-mixed", "cpu", avx2) == "bf16-mixed"
+    assert "without native bf16" in caplog.text and "trainer.precision=32-true" in caplog.text
+    caplog.clear()
+    with caplog.at_level(logging.WARNING, logger="vnrrt.training.train"):
+        assert resolve_precision("bf16-mixed", "cpu", native) == "bf16-mixed"
+        assert resolve_precision("bf16-mixed", "cpu", tmp_path / "absent") == "bf16-mixed"
+        assert resolve_precision("32-true", "cpu", avx2) == "32-true"
+        assert resolve_precision("auto", "cpu", avx2) == "32-true"
+    assert caplog.text == ""
+    assert cpu_bf16_flags(native) == {"avx512_bf16", "amx_bf16"} and cpu_bf16_flags(avx2) == set()
+    arm = tmp_path / "arm"
+    arm.write_text("processor\t: 0\nFeatures\t: fp asimd bf16\n")
+    assert cpu_bf16_flags(arm) is None  # not x86: unknown, no warning
