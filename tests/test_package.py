@@ -1,5 +1,7 @@
 """vnrrt works outside the repository: a wheel installed into a fresh virtual environment
-runs `vnrrt plan` on a PNG map from another folder (no conf/, no source tree)."""
+imports from there and answers its command line from another folder (no conf/, no source
+tree); the slow test also plans on a PNG map there (the installed package compiles its numba
+kernels afresh, ~45 s: its cache is keyed by the source files' paths)."""
 
 import shutil
 import site
@@ -10,9 +12,14 @@ from pathlib import Path
 
 import cv2
 import numpy as np
+import pytest
 
 
-def test_the_wheel_plans_outside_the_repository(repo, tmp_path):
+@pytest.fixture(scope="module")
+def installed(repo, tmp_path_factory) -> tuple[Path, str, Path]:
+    """``(python, purelib, folder)``: the wheel of the repository installed into a fresh
+    virtual environment, and an empty folder outside the repository."""
+    tmp_path = tmp_path_factory.mktemp("wheel")
     source = tmp_path / "source"  # a copy: setuptools leaves build/ in the tree it builds
     shutil.copytree(repo / "src", source / "src", ignore=shutil.ignore_patterns("__pycache__"))
     for name in ("pyproject.toml", "README.md", "LICENSE"):
@@ -35,13 +42,30 @@ def test_the_wheel_plans_outside_the_repository(repo, tmp_path):
                     purelib, str(wheel)], check=True, capture_output=True)  # fmt: skip
     work = tmp_path / "elsewhere"
     work.mkdir()
+    return py, purelib, work
+
+
+def test_the_wheel_installs_and_answers_outside_the_repository(installed, repo):
+    py, purelib, work = installed
+    code = "import vnrrt, vnrrt.planners, vnrrt.cli; print(vnrrt.__file__)"
+    where = subprocess.run([py, "-c", code], cwd=work, capture_output=True, text=True,
+                           check=True).stdout  # fmt: skip
+    assert str(repo) not in where and purelib in where
+    assert Path(purelib, "vnrrt", "py.typed").is_file()
+    out = subprocess.run([py, "-m", "vnrrt", "--version"], cwd=work, capture_output=True,
+                         text=True, check=True).stdout  # fmt: skip
+    assert out.strip() == f"vnrrt {__import__('vnrrt').__version__}"
+    out = subprocess.run([py, "-m", "vnrrt", "plan", "--help"], cwd=work, capture_output=True,
+                         text=True, check=True).stdout  # fmt: skip
+    assert "--map" in out and "--stop" in out
+
+
+@pytest.mark.slow
+def test_the_wheel_plans_outside_the_repository(installed):
+    py, _, work = installed
     img = np.full((60, 60), 255, np.uint8)
     img[10:50, 28:32] = 0  # a dark wall
     cv2.imwrite(str(work / "map.png"), img)
-    where = subprocess.run([py, "-c", "import vnrrt, sys; print(vnrrt.__file__)"], cwd=work,
-                           capture_output=True, text=True, check=True).stdout  # fmt: skip
-    assert str(repo) not in where and purelib in where
-    assert Path(purelib, "vnrrt", "py.typed").is_file()
     out = subprocess.run([py, "-m", "vnrrt", "plan", "--map", "map.png", "--start", "5.5,30.5",
                           "--goal", "55.5,30.5", "--stop", "optimal", "--out", "plan.png"],
                          cwd=work, capture_output=True, text=True)  # fmt: skip
