@@ -12,6 +12,7 @@ prints every stage's closure as ``dvc.yaml`` deps.
 from __future__ import annotations
 
 import ast
+import functools
 import sys
 from pathlib import Path
 
@@ -142,15 +143,30 @@ def declared(deps: list[str]) -> set[Path]:
     return out
 
 
+@functools.cache
+def _dvc_stages() -> dict:
+    """``dvc.yaml``'s stages, parsed once per test process."""
+    import yaml
+
+    return yaml.safe_load((REPO / "dvc.yaml").read_text())["stages"]
+
+
+@functools.cache
+def _default_config():
+    """The default composition, composed once per test process (read only here)."""
+    from vnrrt.config import compose
+
+    return compose()
+
+
 def declared_params(stage: str) -> dict:
     """The parameters ``stage``'s ``dvc.yaml`` entry declares, from the default composition."""
-    import yaml
     from omegaconf import OmegaConf
 
-    from vnrrt.config import compose, restrict, stage_params
+    from vnrrt.config import restrict, stage_params
 
-    cfg = compose()
-    entry = yaml.safe_load((REPO / "dvc.yaml").read_text())["stages"][stage]
+    cfg = _default_config()
+    entry = _dvc_stages()[stage]
     if "foreach" in entry:  # ${scale.shards} -> the first id (a stand-in for an empty list)
         stage = f"{stage}@{_first(cfg, entry['foreach'])}"
     if "matrix" in entry:  # the first value of each axis: stage@<a>-<b>
@@ -170,10 +186,8 @@ def _first(cfg, items: str) -> str:
 
 def stage_scripts() -> dict[str, Path]:
     """``{stage name: script}`` of every ``dvc.yaml`` stage (from its ``cmd``)."""
-    import yaml
-
     out = {}
-    for name, entry in yaml.safe_load((REPO / "dvc.yaml").read_text())["stages"].items():
+    for name, entry in _dvc_stages().items():
         cmd = entry.get("do", entry)["cmd"]
         out[name] = REPO / next(w for w in cmd.split() if w.startswith("stages/"))
     return out
