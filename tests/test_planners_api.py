@@ -16,8 +16,10 @@ from vnrrt.planners import (
     astar_length,
     make_sampler,
     plan,
+    run,
     segment_free,
 )
+from vnrrt.planners import tree as nodes
 from vnrrt.search import NoPathError, astar
 
 START, GOAL = (20.5, 30.5), (180.5, 40.5)
@@ -292,6 +294,46 @@ def test_a_planner_set_up_once_answers_as_plan_does(grid, heat, planner):
         assert (a.cost, a.iterations, a.tree_size, a.collision_checks) == (
             b.cost, b.iterations, b.tree_size, b.collision_checks)  # fmt: skip
         np.testing.assert_array_equal(a.path, b.path)
+
+
+def test_one_shot_plans_reuse_a_pooled_tree_and_give_the_same_results(grid, monkeypatch):
+    """plan() takes its tree's arrays from run.POOL and gives them back: the second call on a
+    map of the same shape allocates nothing, answers exactly as a fresh tree does, and shares
+    no array with the first call's result; a tree that grew is not kept."""
+    run.POOL.clear()
+    made = []
+    new_tree = nodes.new_tree
+    monkeypatch.setattr(nodes, "new_tree", lambda c, *a: made.append(c) or new_tree(c, *a))
+    cfg = PlannerConfig(max_iterations=3000)
+    a = plan(grid, START, GOAL, stop="optimal", seed=3, config=cfg)
+    path, trace = a.path.copy(), a.trace_costs.copy()
+    b = plan(grid, START, GOAL, stop="optimal", seed=3, config=cfg)
+    assert len(made) == 1  # the second call reused the first one's tree
+    np.testing.assert_array_equal(a.path, path)  # not overwritten by the second run
+    np.testing.assert_array_equal(a.trace_costs, trace)
+    c = Planner(grid, config=cfg).solve(START, GOAL, stop="optimal", seed=3)  # its own tree
+    assert len(made) == 2
+    for r in (b, c):
+        assert (r.cost, r.iterations, r.tree_size, r.collision_checks) == (
+            a.cost, a.iterations, a.tree_size, a.collision_checks)  # fmt: skip
+        np.testing.assert_array_equal(r.path, a.path)
+    run.POOL.clear()
+    big = PlannerConfig(max_iterations=20_000)
+    r = plan(grid, START, GOAL, stop="optimal", reference_length=1.0, seed=0, config=big)
+    assert r.tree_size > run.FIRST_CAPACITY  # it grew, so it was not given back
+    assert run.POOL.take((run.FIRST_CAPACITY, grid.shape, 5.0, big.trace_capacity)) is None
+
+
+def test_the_tree_pool_is_bounded():
+    pool = run.TreePool(keys=2, per_key=1)
+    trees = [run.Tree(8, (4, 4), 1.0, 4) for _ in range(4)]
+    pool.give("a", trees[0])
+    pool.give("a", trees[1])  # over per_key: dropped
+    pool.give("b", trees[2])
+    pool.give("c", trees[3])  # over keys: the oldest key ("a") goes
+    assert pool.take("a") is None
+    assert pool.take("b") is trees[2] and pool.take("c") is trees[3]
+    assert pool.take("b") is None
 
 
 @pytest.mark.parametrize(

@@ -22,6 +22,7 @@ from vnrrt.planners import (
     heatmap_sampler,
     path_free,
     plan,
+    run,
     uniform_sampler,
 )
 from vnrrt.planners import tree as nodes
@@ -231,6 +232,7 @@ def test_tree_memory_follows_the_work_done_not_the_budget(monkeypatch):
     even with a budget of a billion iterations; a longer run doubles the room when full,
     up to the budget (+ root and goal)."""
     warmup()  # its own small runs first
+    run.POOL.clear()  # no tree of an earlier plan() to reuse
     sizes = []
     new_tree, enlarge = nodes.new_tree, nodes.enlarge
     monkeypatch.setattr(nodes, "new_tree", lambda c, *a: sizes.append(c) or new_tree(c, *a))
@@ -240,6 +242,7 @@ def test_tree_memory_follows_the_work_done_not_the_budget(monkeypatch):
     r = plan(fm.grid, s, g, config=PlannerConfig(max_iterations=10**9), seed=0)
     assert r.success and sizes == [FIRST_CAPACITY] and r.tree_size < FIRST_CAPACITY
     sizes.clear()
+    run.POOL.clear()
     r = plan(fm.grid, s, g, stop="optimal", reference_length=1.0,
              config=PlannerConfig(max_iterations=10_000))  # fmt: skip
     assert r.stop_reason == "max_iterations" and r.iterations == 10_000

@@ -179,6 +179,7 @@ class Planner:
         else:
             check_sampler(sampler, planner, self.occ.shape, self.config)
         self.sampler = sampler
+        self._pooled = False  # plan()'s one-shot planner: its tree comes from run.POOL
 
     @functools.cached_property
     def _work(self) -> run.Workspace:
@@ -186,7 +187,7 @@ class Planner:
         cfg = self.config
         budget = run.Budget(cfg.max_iterations, cfg.max_seconds, cfg.trace_capacity)
         bucket = max(min(cfg.eta, max(self.occ.shape)) / 2, 1.0)  # an unlimited step: the map
-        return run.Workspace(self.occ.shape, bucket, budget)
+        return run.Workspace(self.occ.shape, bucket, budget, pooled=self._pooled)
 
     @functools.cached_property
     def draws(self) -> core.Draws:
@@ -315,8 +316,13 @@ def plan(
     computed); ``seed`` an int >= 0 or a tuple of them. Arguments and errors: :class:`Planner`
     and :meth:`Planner.solve`. Returns a :class:`PlanResult`."""
     p = Planner(grid, planner, heatmap=heatmap, config=config, sampler=sampler)
-    return p.solve(start, goal, stop=stop, reference_length=reference_length, seed=seed,
-                   milestones=milestones, keep_tree=keep_tree)  # fmt: skip
+    p._pooled = True  # a one-shot planner: its tree's arrays are reused by the next plan()
+    try:
+        return p.solve(start, goal, stop=stop, reference_length=reference_length, seed=seed,
+                       milestones=milestones, keep_tree=keep_tree)  # fmt: skip
+    finally:
+        if "_work" in p.__dict__:  # a tree was made (not for a free straight segment)
+            p._work.release()
 
 
 @functools.cache

@@ -1,27 +1,31 @@
 """One planner run on validated inputs: the timed region of :meth:`vnrrt.planners.Planner.solve`.
 
-The clock starts before the straight start-goal segment is tested (when ``straight_first``)
-and stops when the stop rule or a budget is met. The tree's arrays are allocated (or emptied
-for reuse) before it starts, as OMPL's ``setup()`` is outside its ``solve()`` times; growing
-them is inside. A free straight segment that meets the stop rule is the exact optimum, known
-after that one segment test: its result (a two-node tree) is written after the clock has
-stopped, like every result. Otherwise the tree grows in compiled chunks of
-:func:`vnrrt.planners.core.grow`, budgets checked between chunks."""
+The clock starts before the straight start-goal segment is tested (when ``straight_first``) and
+stops when the stop rule or a budget is met. The tree's arrays are allocated (or emptied for
+reuse) before it starts, as OMPL's ``setup()`` is outside its ``solve()`` times; growing them is
+inside. A free straight segment that meets the stop rule is the exact optimum, known after that
+one segment test: its result (a two-node tree) is written after the clock has stopped, like
+every result. Otherwise the tree grows in compiled chunks of :func:`vnrrt.planners.core.grow`,
+budgets checked between chunks: all in one compiled call on 64-bit Linux
+(:func:`drive_compiled`, :mod:`.loop`), else returning to Python after each chunk
+(:func:`drive_python`); both grow the same tree. A one-shot :func:`vnrrt.planners.plan` takes
+its tree's arrays from :data:`POOL`."""
 
 from __future__ import annotations
 
 import math
+import threading
 import time
 from typing import NamedTuple
 
 import numpy as np
 
-from vnrrt.planners import core
+from vnrrt.planners import clock, core, loop
 from vnrrt.planners import tree as nodes
 from vnrrt.planners.collision import polyline_length
+from vnrrt.planners.loop import FIRST_CHUNK, MAX_CHUNK
 from vnrrt.planners.result import Milestone, PlanResult
 
-FIRST_CHUNK, MAX_CHUNK = 64, 4096  # iterations per compiled call; budgets checked between
 FIRST_CAPACITY = 4096  # tree nodes allocated first; doubled when full (up to the budget)
 
 
@@ -88,20 +92,69 @@ class Tree:
 class Workspace:
     """The arrays of the runs of one :class:`vnrrt.planners.Planner` on one map: allocated by
     the first run (``FIRST_CAPACITY`` nodes, grown as needed), emptied and reused by the next
-    ones. One run at a time."""
+    ones. One run at a time. A one-shot workspace (``pooled``, what :func:`vnrrt.planners.plan`
+    uses) takes its first tree from :data:`POOL` and gives it back by :meth:`release`."""
 
-    def __init__(self, shape: tuple[int, int], bucket: float, budget: Budget):
+    def __init__(self, shape: tuple[int, int], bucket: float, budget: Budget, pooled=False):
         self.shape, self.bucket, self.budget = shape, bucket, budget
+        self.pooled = pooled
         self._tree: Tree | None = None
 
+    @property
+    def _key(self) -> tuple:
+        capacity = min(self.budget.max_iterations + 2, FIRST_CAPACITY)
+        return capacity, tuple(self.shape), self.bucket, self.budget.trace_capacity
+
     def fresh(self) -> Tree:
-        """An empty tree (newly allocated the first time)."""
+        """An empty tree (newly allocated, or taken from the pool, the first time)."""
         if self._tree is None:
-            capacity = min(self.budget.max_iterations + 2, FIRST_CAPACITY)
-            self._tree = Tree(capacity, self.shape, self.bucket, self.budget.trace_capacity)
-        else:
-            self._tree.reset()
+            key = self._key
+            self._tree = POOL.take(key) if self.pooled else None
+            if self._tree is None:
+                self._tree = Tree(key[0], self.shape, self.bucket, key[3])
+        self._tree.reset()
         return self._tree
+
+    def release(self) -> None:
+        """Give the tree back to the pool (a pooled workspace of first size; no run may use
+        it afterwards). A tree that grew is dropped, so the pool never holds a large one."""
+        tree, self._tree = self._tree, None
+        if self.pooled and tree is not None and tree.capacity == self._key[0]:
+            POOL.give(self._key, tree)
+
+
+class TreePool:
+    """Emptied trees of finished one-shot runs, for the next one on a map of the same shape
+    and settings (the allocation and first touch of a tree's ~0.4 MB cost a one-shot call
+    more than a short run): at most ``per_key`` trees for each of the ``keys`` most recent
+    keys ``(capacity, shape, bucket, trace capacity)``. Thread-safe; results never share
+    a tree's arrays (:func:`result` copies what it returns)."""
+
+    def __init__(self, keys: int = 8, per_key: int = 2):
+        self.keys, self.per_key = keys, per_key
+        self._trees: dict[tuple, list[Tree]] = {}
+        self._lock = threading.Lock()
+
+    def take(self, key: tuple) -> Tree | None:
+        with self._lock:
+            trees = self._trees.get(key)
+            return trees.pop() if trees else None
+
+    def give(self, key: tuple, tree: Tree) -> None:
+        with self._lock:
+            trees = self._trees.pop(key, [])  # re-inserted: the most recent key last
+            if len(trees) < self.per_key:
+                trees.append(tree)
+            self._trees[key] = trees
+            while len(self._trees) > self.keys:
+                del self._trees[next(iter(self._trees))]
+
+    def clear(self) -> None:
+        with self._lock:
+            self._trees.clear()
+
+
+POOL = TreePool()
 
 
 def stop_bounds(query: Query) -> np.ndarray:
@@ -114,8 +167,8 @@ def stop_bounds(query: Query) -> np.ndarray:
 def straight_test(occ: np.ndarray, query: Query) -> tuple[float, float]:
     """The start-goal distance when the segment between them is free (-1 when blocked), and
     the seconds the test took (the first part of a run's time)."""
-    t0 = time.perf_counter()
     (sx, sy), (gx, gy) = query.start, query.goal
+    t0 = time.perf_counter()
     d = core.straight_cost(occ, sx, sy, gx, gy)
     return d, time.perf_counter() - t0
 
@@ -124,31 +177,37 @@ def straight_result(planner: str, query: Query, d: float, found: float) -> PlanR
     """The result of a run answered after ``found`` seconds by the free straight segment of
     length ``d``: the tree is the root and the goal joined to it (one segment test). The
     cost is ``d``, equal to the polyline length of the path (both are libm's ``hypot``)."""
-    path = np.array((query.start, query.goal))
-    extra = tuple(Milestone(b, found, 0) if d <= b else Milestone(b) for b in query.bounds)
-    return PlanResult.of({
-        "planner": planner,
-        "success": True,
-        "stop_reason": "solved",
-        "path": path,
-        "cost": d,
-        "iterations": 0,
-        "tree_size": 2,
-        "collision_checks": 1,
-        "time_to_first": found,
-        "time_to_stop": found,
-        "first_cost": d,
-        "first_iteration": 0,
-        "trace_iterations": np.zeros(1, np.int64),
-        "trace_costs": np.array([d]),
-        "reference_length": query.reference_length,
-        "target_cost": query.target,
-        "milestones": extra,
-        "fallback_uniform": query.fallback_uniform,
-        "setup_time": query.setup_time,
-        "tree_points": path.copy() if query.keep_tree else None,
-        "tree_parents": np.array([-1, 0], np.int64) if query.keep_tree else None,
-    })  # fmt: skip
+    (sx, sy), (gx, gy) = query.start, query.goal
+    path = np.empty((2, 2))
+    path[0, 0], path[0, 1], path[1, 0], path[1, 1] = sx, sy, gx, gy
+    costs = np.empty(1)
+    costs[0] = d
+    values = dict(_STRAIGHT)  # the fields every straight answer shares
+    values["planner"], values["path"], values["cost"] = planner, path, d
+    values["time_to_first"] = values["time_to_stop"] = found
+    values["first_cost"], values["trace_costs"] = d, costs
+    values["trace_iterations"] = np.zeros(1, np.int64)
+    values["reference_length"], values["target_cost"] = query.reference_length, query.target
+    values["fallback_uniform"], values["setup_time"] = query.fallback_uniform, query.setup_time
+    if query.bounds:
+        values["milestones"] = tuple(Milestone(b, found, 0) if d <= b else Milestone(b)
+                                     for b in query.bounds)  # fmt: skip
+    if query.keep_tree:
+        values["tree_points"], values["tree_parents"] = path.copy(), np.array([-1, 0], np.int64)
+    return PlanResult.of(values)
+
+
+_STRAIGHT = {
+    "success": True,
+    "stop_reason": "solved",
+    "iterations": 0,
+    "tree_size": 2,
+    "collision_checks": 1,
+    "first_iteration": 0,
+    "milestones": (),
+    "tree_points": None,
+    "tree_parents": None,
+}
 
 
 def search(
@@ -169,55 +228,88 @@ def search(
     stops = stop_bounds(query)
     run = work.fresh()  # allocated (or emptied) before the clock starts, as OMPL's setup()
     first = tuple(params._replace(goal_radius=math.inf) if straight else params)
-    tree, _, counters, trace = run.flat
+    drive = drive_compiled if clock.IN_KERNEL else drive_python
     t0 = time.perf_counter() - spent
-    core.plant_flat(occ, tree, counters, run.scratch.stack, trace, first, stops)
-    reason, times, iters = drive(run, occ, draws=draws, params=params, rng=rng, stops=stops,
-                                 target=query.target, budget=work.budget, t0=t0)  # fmt: skip
+    job = Job(draws, params, first, rng, stops, query.target, work.budget, t0)
+    reason, times, iters = drive(run, occ, job)
     elapsed = time.perf_counter() - t0
     reached = {b: (float(t), int(i)) for b, t, i in zip(stops, times, iters, strict=True)}
     return result(run, planner, query, reason=reason, reached=reached, elapsed=elapsed)
 
 
-def drive(
-    run: Tree,
-    occ: np.ndarray,
-    *,
-    draws: core.Draws,
-    params: core.Params,
-    rng: np.ndarray,
-    stops: np.ndarray,
-    target: float | None,
-    budget: Budget,
-    t0: float,
-) -> tuple[str, list[float], list[int]]:
-    """Grow the planted tree in compiled chunks until the stop rule or a budget is met.
+REASONS = {loop.SOLVED: "solved", loop.MAX_ITERATIONS: "max_iterations",
+           loop.MAX_SECONDS: "max_seconds"}  # fmt: skip
+
+
+class Job(NamedTuple):
+    """What a run's loop reads besides the tree and the grid: the sampler, the run's
+    settings (``first``: those of planting, a plain tuple), the rng state, the stop bounds
+    (decreasing), the stop bound to meet (None: the first solution), the budgets and the
+    run's start ``t0`` (``time.perf_counter`` seconds)."""
+
+    draws: core.Draws
+    params: core.Params
+    first: tuple
+    rng: np.ndarray
+    stops: np.ndarray
+    target: float | None
+    budget: Budget
+    t0: float
+
+
+def drive_compiled(run: Tree, occ: np.ndarray, job: Job) -> tuple[str, np.ndarray, np.ndarray]:
+    """:func:`drive_python` in one compiled call (:func:`vnrrt.planners.loop.drive`), back in
+    Python only to enlarge a full tree; the same tree, iterations and costs."""
+    m, budget = len(job.stops), job.budget
+    times, iters = np.full(m, np.nan), np.full(m, -1, np.int64)
+    state = np.array([FIRST_CHUNK, 0, 1], np.int64)  # chunk, bounds passed, plant
+    target = math.inf if job.target is None else float(job.target)
+    limits = (target, int(budget.max_iterations), float(budget.max_seconds), job.t0)
+    rest = (tuple(job.draws), job.stops, tuple(job.params), job.first, limits, state, times, iters)
+    while True:
+        code = loop.drive_flat(occ, *run.flat, job.rng, *rest)
+        if code != core.TREE_FULL:
+            return REASONS[code], times, iters
+        make_room(run, budget)
+
+
+def make_room(run: Tree, budget: Budget) -> None:
+    """Double a full tree's room, up to the budget's (root, goal and a node per iteration)."""
+    if run.capacity >= budget.max_iterations + 2:
+        raise RuntimeError(f"tree of {run.capacity} nodes full before the budget")
+    run.enlarge(min(2 * run.capacity, budget.max_iterations + 2))
+
+
+def drive_python(run: Tree, occ: np.ndarray, job: Job) -> tuple[str, list[float], list[int]]:
+    """Plant the tree and grow it in compiled chunks until the stop rule or a budget is met,
+    timing it in Python (where :data:`vnrrt.planners.clock.IN_KERNEL` is False).
 
     Returns ``(stop_reason, times, iterations)``: per entry of ``stops`` (decreasing cost
     bounds), the time (s since ``t0``, ``time.perf_counter``) and iteration at which it was
     first reached (NaN / -1: never).
     """
+    tree, _, c, trace = run.flat
+    stops, budget = job.stops, job.budget
+    core.plant_flat(occ, tree, c, run.scratch.stack, trace, job.first, stops)
     c = run.counters
     times, iters = [math.nan] * len(stops), [-1] * len(stops)
     chunk, passed, status = FIRST_CHUNK, 0, core.RUNNING
-    draws_t, params_t = tuple(draws), tuple(params)
+    draws_t, params_t = tuple(job.draws), tuple(job.params)
     while True:
-        now = time.perf_counter() - t0
+        now = time.perf_counter() - job.t0
         for m in range(passed, int(c.milestone[0])):
             times[m], iters[m] = now, int(c.iters[0])
         passed = int(c.milestone[0])
-        if run.solved(target):
+        if run.solved(job.target):
             return "solved", times, iters
         if status == core.TREE_FULL:
-            if run.capacity >= budget.max_iterations + 2:  # root, goal and a node per iteration
-                raise RuntimeError(f"tree of {run.capacity} nodes full before the budget")
-            run.enlarge(min(2 * run.capacity, budget.max_iterations + 2))
+            make_room(run, budget)
         if c.iters[0] >= budget.max_iterations:
             return "max_iterations", times, iters
         if now >= budget.max_seconds:
             return "max_seconds", times, iters
         n = min(chunk, budget.max_iterations - int(c.iters[0]))
-        status = core.grow_flat(occ, *run.flat, rng, draws_t, stops, params_t, n)
+        status = core.grow_flat(occ, *run.flat, job.rng, draws_t, stops, params_t, n)
         chunk = min(2 * chunk, MAX_CHUNK)
 
 
