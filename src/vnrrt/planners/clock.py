@@ -1,5 +1,5 @@
 """The clock of :func:`time.perf_counter`, read from compiled code, so that a planner run
-can time itself without returning to Python (:func:`vnrrt.planners.core.drive`).
+can time itself without returning to Python (:func:`vnrrt.planners.loop.drive`).
 
 On 64-bit Linux ``time.perf_counter()`` is ``clock_gettime(CLOCK_MONOTONIC)`` in seconds;
 :func:`monotonic` reads the same clock from inside a numba function (about 40 ns a read,

@@ -92,8 +92,7 @@ def point_free(occ: np.ndarray, point) -> bool:
 
 def polyline_length(path: np.ndarray) -> float:
     """Euclidean length (pixels) of a polyline ``(K, 2)`` (x, y); 0 for ``K < 2``."""
-    p = path if type(path) is np.ndarray and path.dtype == np.float64 else np.asarray(
-        path, dtype=np.float64)  # fmt: skip
+    p = np.asarray(path, dtype=np.float64)
     if len(p) < 2:
         return 0.0
     d = p[1:] - p[:-1]  # np.diff's values, without its overhead

@@ -118,9 +118,9 @@ class Workspace:
     def release(self) -> None:
         """Give the tree back to the pool (a pooled workspace of first size; no run may use
         it afterwards). A tree that grew is dropped, so the pool never holds a large one."""
-        tree, self._tree = self._tree, None
-        if self.pooled and tree is not None and tree.capacity == self._key[0]:
-            POOL.give(self._key, tree)
+        tree, self._tree, key = self._tree, None, self._key
+        if self.pooled and tree is not None and tree.capacity == key[0]:
+            POOL.give(key, tree)
 
 
 class TreePool:
@@ -177,37 +177,31 @@ def straight_result(planner: str, query: Query, d: float, found: float) -> PlanR
     """The result of a run answered after ``found`` seconds by the free straight segment of
     length ``d``: the tree is the root and the goal joined to it (one segment test). The
     cost is ``d``, equal to the polyline length of the path (both are libm's ``hypot``)."""
-    (sx, sy), (gx, gy) = query.start, query.goal
-    path = np.empty((2, 2))
-    path[0, 0], path[0, 1], path[1, 0], path[1, 1] = sx, sy, gx, gy
-    costs = np.empty(1)
-    costs[0] = d
-    values = dict(_STRAIGHT)  # the fields every straight answer shares
-    values["planner"], values["path"], values["cost"] = planner, path, d
-    values["time_to_first"] = values["time_to_stop"] = found
-    values["first_cost"], values["trace_costs"] = d, costs
-    values["trace_iterations"] = np.zeros(1, np.int64)
-    values["reference_length"], values["target_cost"] = query.reference_length, query.target
-    values["fallback_uniform"], values["setup_time"] = query.fallback_uniform, query.setup_time
-    if query.bounds:
-        values["milestones"] = tuple(Milestone(b, found, 0) if d <= b else Milestone(b)
-                                     for b in query.bounds)  # fmt: skip
-    if query.keep_tree:
-        values["tree_points"], values["tree_parents"] = path.copy(), np.array([-1, 0], np.int64)
-    return PlanResult.of(values)
-
-
-_STRAIGHT = {
-    "success": True,
-    "stop_reason": "solved",
-    "iterations": 0,
-    "tree_size": 2,
-    "collision_checks": 1,
-    "first_iteration": 0,
-    "milestones": (),
-    "tree_points": None,
-    "tree_parents": None,
-}
+    path = np.array((query.start, query.goal))
+    extra = tuple(Milestone(b, found, 0) if d <= b else Milestone(b) for b in query.bounds)
+    return PlanResult.of({
+        "planner": planner,
+        "success": True,
+        "stop_reason": "solved",
+        "path": path,
+        "cost": d,
+        "iterations": 0,
+        "tree_size": 2,
+        "collision_checks": 1,
+        "time_to_first": found,
+        "time_to_stop": found,
+        "first_cost": d,
+        "first_iteration": 0,
+        "trace_iterations": np.zeros(1, np.int64),
+        "trace_costs": np.array([d]),
+        "reference_length": query.reference_length,
+        "target_cost": query.target,
+        "milestones": extra,
+        "fallback_uniform": query.fallback_uniform,
+        "setup_time": query.setup_time,
+        "tree_points": path.copy() if query.keep_tree else None,
+        "tree_parents": np.array([-1, 0], np.int64) if query.keep_tree else None,
+    })  # fmt: skip
 
 
 def search(
