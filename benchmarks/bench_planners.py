@@ -3,7 +3,8 @@
 In one process, on the same maps (:mod:`planner_maps`: a development set and a held-out set,
 reported apart) and start/goal pairs, alternating per trial: our best configuration
 (``ours-best``, :data:`vnrrt.planners.FASTEST`: informed, straight segment first, goal joined
-by any node that sees it, Steer step 20 px, path refinement, pulled parents) and our
+by any node that sees it, Steer step 20 px, path refinement, pulled parents, the gap sampler)
+and our
 paper-setting RRT* (step 10 px); native OMPL 1.5
 (a C++ harness built here against the system's ``libompl-dev``, :mod:`ompl_native`): RRTstar,
 InformedRRTstar, BITstar, ABITstar and AITstar at their defaults and the two RRT* planners at
@@ -16,11 +17,12 @@ OMPL's ``solve()``, its setup apart), the time to its first solution and to a co
 of the exact continuous optimum (:func:`vnrrt.planners.any_angle_path`); a run stops there or
 at ``--time-limit`` (a miss counts as the limit: medians marked ">=" are lower bounds).
 ``ours-call`` is the whole ``plan()`` call (input checks, setup, seeding and result
-included). Per map: medians over trials and the ratio of the best native OMPL planner's
-median to ours; overall: each planner's median over maps, the ratio of the best OMPL
-planner's (native, then Python) to ours, and the median and worst per-map ratio (for the
-whole call too). The
-floor is the exact visibility-graph solve itself, timed per map. Every path of ours is checked
+included); our calls run with the garbage collector off and their garbage is collected
+after them (``--collect-before``: right before each call, the earlier method, which leaves
+the call's caches cold). Per map: medians over trials and the ratio of the best native OMPL
+planner's median to ours; overall: each planner's median over maps, the ratio of the best
+OMPL planner's (native, then Python) to ours, and the median and worst per-map ratio (for
+the whole call too). The floor is the exact visibility-graph solve itself, timed per map. Every path of ours is checked
 with the exact segment test and against the stop rule (exit 1 if one fails); OMPL's paths that
 clip an obstacle corner under that test are counted. Exit 2 when the harness cannot be built.
 
@@ -49,13 +51,22 @@ NATIVE = [*ompl_native.PLANNERS, "RRTstar-m", "InformedRRTstar-m"]
 PYTHON = [*ompl_python.PLANNERS, "RRTstar-m", "InformedRRTstar-m"]
 
 
+COLLECT_BEFORE = False  # --collect-before: the method of the runs before 2026-12-02 (see main)
+
+
 def run_ours(g, s, e, exact, seed, config) -> dict:
-    """Our planner to 1% of ``exact``; times of the run and of the whole call (the other
-    planners' garbage collected first, so that its collection is not timed in our call)."""
-    gc.collect()
-    t0 = time.perf_counter()
-    r = plan(g, s, e, stop="optimal", reference_length=exact, seed=seed, config=config)
-    call = time.perf_counter() - t0
+    """Our planner to 1% of ``exact``; times of the run and of the whole call, made with
+    Python's garbage collector off (as :mod:`timeit` does; garbage is collected after our
+    calls of a trial, before OMPL's: :func:`bench_map`)."""
+    if COLLECT_BEFORE:
+        gc.collect()
+    gc.disable()
+    try:
+        t0 = time.perf_counter()
+        r = plan(g, s, e, stop="optimal", reference_length=exact, seed=seed, config=config)
+        call = time.perf_counter() - t0
+    finally:
+        gc.enable()
     ok = path_free(g, r.path) and (not r.success or r.cost <= 1.01 * exact + 1e-9)
     stop = r.time_to_stop if r.success else math.nan
     return {"first": r.time_to_first, "stop": stop, "call": call if r.success else math.nan,
@@ -96,6 +107,7 @@ def bench_map(native, g, s, e, trials, limit, seed, python) -> dict:
         for label, config in OURS.items():
             config = config.replace(max_seconds=limit)  # validated here, not in the timed call
             runs.setdefault(label, []).append(run_ours(g, s, e, exact, (*seed, k), config))
+        gc.collect()  # our calls' garbage, outside every timed call
         for name in NATIVE:
             runs.setdefault(f"n-{name}", []).append(run_native(native, g, s, e, bound, limit, name))
         for name in PYTHON if python else ():
@@ -205,7 +217,12 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--maps", help="only these maps (comma-separated names)")
     ap.add_argument("--no-python", action="store_true", help="skip OMPL's Python bindings")
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--collect-before", action="store_true",
+                    help="collect garbage right before each of our calls (the runs before "
+                         "2026-12-02: it leaves the next call's caches cold)")  # fmt: skip
     args = ap.parse_args(argv)
+    global COLLECT_BEFORE
+    COLLECT_BEFORE = args.collect_before
     binary = ompl_native.build_or_explain()
     if binary is None:
         return 2

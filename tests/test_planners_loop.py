@@ -30,6 +30,8 @@ CASES = [
     ("vnrrt_star", PlannerConfig(informed=True), "optimal", (1.5,)),
     ("m_vnrrt_star", PlannerConfig(tau=0.5), "initial", ()),
     ("rrt_star", PlannerConfig(max_iterations=9000), "unreachable", ()),  # the tree fills up
+    ("rrt_star", FASTEST.replace(gap_share=0.3, gap_after=100), "optimal", (1.1,)),  # gaps
+    ("vnrrt_star", PlannerConfig(gap_share=0.2, gap_width=4), "initial", ()),
 ]
 
 

@@ -10,7 +10,8 @@ search only: building the sampler from a heatmap (per map, once; reported as
 seeding, JIT compilation (once per process, :func:`warmup`) and the reference-length
 computation (an oracle, not part of planning) are outside the timed region. With
 ``straight_first``, a free start-goal segment that meets the stop rule is the answer: the run's
-time is that one segment test (:mod:`.run`).
+time is that one segment test (:mod:`.run`). The gap sampler's cells (``gap_share``) are found
+inside the run, at its iteration ``gap_after``.
 """
 
 from __future__ import annotations
@@ -192,9 +193,11 @@ class Planner:
     @functools.cached_property
     def draws(self) -> core.Draws:
         """The sampler as the core reads it."""
-        s = self.sampler
+        s, cfg = self.sampler, self.config
         cdf = s.cdf if s.cdf.size else np.zeros(1)
-        return core.Draws(float(s.draw_mix), cdf, max(s.last, 0))
+        share = float(cfg.gap_share)  # the gap cells pending (-1) when used: found in the run
+        return core.Draws(float(s.draw_mix), cdf, max(s.last, 0), share, int(cfg.gap_width),
+                          int(cfg.gap_after), core.NO_CELLS, -1 if share > 0 else 0)  # fmt: skip
 
     @functools.cached_property
     def gamma(self) -> float:
@@ -340,4 +343,5 @@ def warmup() -> None:
             p._run(query, 0)
     core.straight_cost(occ, 0.5, 0.5, 1.5, 1.5)
     points_free(occ, 0.5, 0.5, 1.5, 1.5)
+    Planner(occ, config=PlannerConfig(max_iterations=200, gap_share=0.5))._run(query, 0)
     log.debug("planner kernels compiled")

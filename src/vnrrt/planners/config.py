@@ -62,6 +62,14 @@ class PlannerConfig:
             corners as they grow. Off in the paper's protocol.
         refine_branches: share of the refinement moves made on the branch of a random tree
             node that could still lead to a better solution, rather than on the best path.
+        gap_share: share of the samples drawn from the map's narrow-passage cells (free
+            cells whose free run along the row or column is at most ``gap_width`` cells:
+            :mod:`vnrrt.planners.gaps`, an exact grid form of the bridge test) instead of the
+            sampler; 0 (the paper's protocol) disables it. The cells are found by each
+            run when it reaches iteration ``gap_after`` (inside its timed region: ~35 us on a
+            200 x 200 map), so that runs ending before it pay nothing for them.
+        gap_width: widest passage (cells) whose cells the gap sampler draws.
+        gap_after: the iteration from which the gap sampler draws.
         max_iterations, max_seconds: budgets; hitting one is a recorded failure.
         trace_capacity: most points kept in the sparse cost-versus-iteration trace.
 
@@ -87,6 +95,9 @@ class PlannerConfig:
     refine: float = 0.0
     pull_parents: bool = False
     refine_branches: float = 0.0
+    gap_share: float = 0.0
+    gap_width: int = 8
+    gap_after: int = 0
     max_iterations: int = 200_000
     max_seconds: float = 30.0
     trace_capacity: int = 1024
@@ -109,7 +120,7 @@ class PlannerConfig:
         self._check(
             "goal_radius", g is None or g == math.inf or (_finite(g) and g > 0), "null, > 0 or .inf"
         )
-        for name in ("refine", "refine_branches"):
+        for name in ("refine", "refine_branches", "gap_share"):
             v = getattr(self, name)
             self._check(name, _finite(v) and 0.0 <= v <= 1.0, "in [0, 1]")
         for name in ("informed", "straight_first", "pull_parents"):
@@ -122,6 +133,10 @@ class PlannerConfig:
         self._check("min_spacing", ok, ">= 0 and < eta")
         ok = _integer(self.max_iterations) and self.max_iterations >= 1
         self._check("max_iterations", ok, "an integer >= 1")
+        ok = _integer(self.gap_width) and self.gap_width >= 1
+        self._check("gap_width", ok, "an integer >= 1")
+        ok = _integer(self.gap_after) and self.gap_after >= 0
+        self._check("gap_after", ok, "an integer >= 0")
         ok = _integer(self.trace_capacity) and self.trace_capacity >= 2
         self._check("trace_capacity", ok, "an integer >= 2")
         self._check("tau", _finite(self.tau), "finite")
@@ -166,4 +181,8 @@ FASTEST = PlannerConfig(
     refine=0.5,
     pull_parents=True,
     refine_branches=0.5,
-)  # our fastest settings (benchmarks/bench_planners.py's ``ours-best``), any planner
+    gap_share=0.3,
+    gap_width=8,
+    gap_after=256,
+)  # our fastest settings (benchmarks/bench_planners.py's ``ours-best``), any planner; the gap
+# sampler's three chosen on the development maps only (benchmarks/select_gaps.py)

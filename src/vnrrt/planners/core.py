@@ -14,6 +14,10 @@ the solution are skipped: a near node ``q`` with ``|q - start| + |q - goal| > c_
 parent or rewiring candidate, and a new node whose cost-to-come plus its straight line to the
 goal exceeds ``c_best`` is not added (no path through it can be better).
 
+**Gaps**, when ``Draws.gap_share > 0``: from iteration ``Draws.gap_after`` on, that share of
+the samples is drawn from the map's narrow-passage cells (:mod:`.gaps`; found then, by
+:func:`with_gaps`, inside the run), inside the ellipse once informed sampling applies.
+
 **Refinement**, when ``Params.refine > 0``: once a solution exists, that share of the
 iterations is a local move on the best path (or, ``refine_branches`` of them, on a promising
 branch) instead of a sample (:mod:`.refine`). **Pulled parents**, when
@@ -36,8 +40,9 @@ from numba import njit
 
 from vnrrt.planners import spatial
 from vnrrt.planners.collision import segment_free
+from vnrrt.planners.gaps import gap_cells
 from vnrrt.planners.refine import AT_REST, IMPROVED, refine_step
-from vnrrt.planners.samplers import informed_point, next_double, sample_point
+from vnrrt.planners.samplers import any_point, next_double
 from vnrrt.planners.tree import (
     PARENT,
     Counters,
@@ -76,13 +81,38 @@ class Params(NamedTuple):
     refine_branches: float = 0.0
 
 
+NO_CELLS = np.zeros(1, np.int64)  # the gap cells of a sampler without (or not yet with) any
+
+
 class Draws(NamedTuple):
     """The sampler: heatmap draw probability ``mix``, cumulative weights ``cdf`` over flat
-    pixels and the last pixel with weight (see :mod:`.samplers`)."""
+    pixels and the last pixel with weight (see :mod:`.samplers`); the gap sampler: its share
+    ``gap_share`` of the samples, the widest passage ``gap_width`` (cells), the iteration
+    ``gap_after`` from which it draws, and the first ``n_gaps`` flat indices of
+    ``gap_cells`` it draws from (:mod:`.gaps`; ``n_gaps`` -1: not found yet, 0: none)."""
 
     mix: float
     cdf: np.ndarray
     last: int
+    gap_share: float = 0.0
+    gap_width: int = 8
+    gap_after: int = 0
+    gap_cells: np.ndarray = NO_CELLS
+    n_gaps: int = 0
+
+
+@njit(cache=True)
+def gaps_due(d, iters):
+    """Iterations that may run before the gap cells of ``d`` must be found (a large number
+    when they are not pending), given ``iters`` done."""
+    return d.gap_after - iters if d.n_gaps < 0 else 1 << 62
+
+
+@njit(cache=True)
+def with_gaps(occ, d):
+    """``d`` with the gap cells of ``occ`` found (:func:`vnrrt.planners.gaps.gap_cells`)."""
+    cells = gap_cells(occ, d.gap_width)
+    return Draws(d.mix, d.cdf, d.last, d.gap_share, d.gap_width, d.gap_after, cells, cells.size)
 
 
 @njit(cache=True, inline="always")
@@ -206,12 +236,11 @@ def near_radius(n, p):
 
 @njit(cache=True)
 def sample(rng, h, w, draws, p, c_best):
-    """Sample: the sampler's draw, inside the informed ellipse once a solution exists."""
-    if p.informed and c_best < np.inf:
-        return informed_point(
-            rng, h, w, draws.mix, draws.cdf, draws.last, p.sx, p.sy, p.gx, p.gy, c_best
-        )
-    return sample_point(rng, h, w, draws.mix, draws.cdf, draws.last)
+    """Sample: the sampler's (or the gap sampler's) draw, inside the informed ellipse once
+    a solution exists (:func:`vnrrt.planners.samplers.any_point`)."""
+    d = draws
+    return any_point(rng, h, w, d.mix, d.cdf, d.last, d.gap_share, d.gap_cells, d.n_gaps,
+                     p.informed and c_best < np.inf, p.sx, p.sy, p.gx, p.gy, c_best)  # fmt: skip
 
 
 @njit(cache=True)

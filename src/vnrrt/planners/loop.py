@@ -4,7 +4,8 @@
 of :func:`vnrrt.planners.core.grow`, in the same order and with the same chunk sizes, so the
 tree, its iterations and its costs are the same: record the time and iteration at which each
 stop bound was first passed, stop when the stop bound is met or a budget is spent, else grow
-another chunk (first :data:`FIRST_CHUNK` iterations, doubling up to :data:`MAX_CHUNK`). It
+another chunk (first :data:`FIRST_CHUNK` iterations, doubling up to :data:`MAX_CHUNK`; a chunk
+ends early at the gap sampler's start, when its cells are found). It
 returns to Python only when the run is over or the tree's arrays are full (the caller
 enlarges them and calls again). Times are seconds on ``time.perf_counter``'s clock
 (:func:`vnrrt.planners.clock.monotonic`) since ``t0``. Without the return to Python after
@@ -23,8 +24,10 @@ from vnrrt.planners.core import (
     TREE_FULL,
     Draws,
     Params,
+    gaps_due,
     grow,
     plant,
+    with_gaps,
 )
 from vnrrt.planners.tree import Counters, Scratch, Trace, Tree
 
@@ -64,7 +67,9 @@ def drive(occ, tree, scratch, counters, trace, rng, draws, stops, p, first, budg
             return MAX_ITERATIONS
         if now >= max_seconds:
             return MAX_SECONDS
-        n = min(state[0], max_iterations - counters.iters[0])
+        if gaps_due(draws, counters.iters[0]) <= 0:
+            draws = with_gaps(occ, draws)
+        n = min(state[0], max_iterations - counters.iters[0], gaps_due(draws, counters.iters[0]))
         status = grow(occ, tree, scratch, counters, trace, rng, draws, stops, p, n)
         state[0] = min(2 * state[0], MAX_CHUNK)
 

@@ -260,7 +260,7 @@ def drive_compiled(run: Tree, occ: np.ndarray, job: Job) -> tuple[str, np.ndarra
     target = math.inf if job.target is None else float(job.target)
     limits = (target, int(budget.max_iterations), float(budget.max_seconds), job.t0)
     rest = (tuple(job.draws), job.stops, tuple(job.params), job.first, limits, state, times, iters)
-    while True:
+    while True:  # after a full tree, the gap cells found in the call are found again (same)
         code = loop.drive_flat(occ, *run.flat, job.rng, *rest)
         if code != core.TREE_FULL:
             return REASONS[code], times, iters
@@ -288,7 +288,8 @@ def drive_python(run: Tree, occ: np.ndarray, job: Job) -> tuple[str, list[float]
     c = run.counters
     times, iters = [math.nan] * len(stops), [-1] * len(stops)
     chunk, passed, status = FIRST_CHUNK, 0, core.RUNNING
-    draws_t, params_t = tuple(job.draws), tuple(job.params)
+    draws, params_t = job.draws, tuple(job.params)
+    draws_t = tuple(draws)
     while True:
         now = time.perf_counter() - job.t0
         for m in range(passed, int(c.milestone[0])):
@@ -302,7 +303,11 @@ def drive_python(run: Tree, occ: np.ndarray, job: Job) -> tuple[str, list[float]
             return "max_iterations", times, iters
         if now >= budget.max_seconds:
             return "max_seconds", times, iters
-        n = min(chunk, budget.max_iterations - int(c.iters[0]))
+        if core.gaps_due(draws, int(c.iters[0])) <= 0:
+            draws = core.with_gaps(occ, draws)
+            draws_t = tuple(draws)
+        due = core.gaps_due(draws, int(c.iters[0]))
+        n = min(chunk, budget.max_iterations - int(c.iters[0]), due)
         status = core.grow_flat(occ, *run.flat, job.rng, draws_t, stops, params_t, n)
         chunk = min(2 * chunk, MAX_CHUNK)
 

@@ -15,6 +15,10 @@ Informed sampling (:func:`informed_point`, used by the core once a solution exis
 ``informed`` is set) draws the same way but inside the ellipse of the points through which a
 shorter path can run.
 
+The **gap sampler** (:func:`gap_point`, any planner, ``PlannerConfig.gap_share``) draws a
+share of the samples from the map's narrow-passage cells (:mod:`.gaps`) instead;
+:func:`any_point` is the one draw the core makes.
+
 If no positive weight is left, the sampler falls back to uniform (no heatmap draws) and sets
 ``fallback_uniform``. Huge or tiny weights are scaled by a power of two before they are summed
 (the draws stay those of the given weights). Randomness comes from a xoshiro256** generator
@@ -231,25 +235,66 @@ def informed_point(s, h, w, mix, cdf, last, sx, sy, gx, gy, c_best):
     return ellipse_uniform(s, h, w, sx, sy, gx, gy, c_best)
 
 
+@njit(cache=True, inline="always")
+def _cell_point(s, w, cells, n):
+    """A uniform point of a cell drawn uniformly from the first ``n`` flat indices of
+    ``cells``."""
+    i = cells[min(int(next_double(s) * n), n - 1)]
+    px, py = float(i % w), float(i // w)
+    return _below(px + next_double(s), px + 1.0), _below(py + next_double(s), py + 1.0)
+
+
 @njit(cache=True)
-def _draw(s, n, h, w, mix, cdf, last, informed, sx, sy, gx, gy, c_best):
-    out = np.empty((n, 2))
-    for k in range(n):
-        if informed:
-            p = informed_point(s, h, w, mix, cdf, last, sx, sy, gx, gy, c_best)
-        else:
-            p = sample_point(s, h, w, mix, cdf, last)
+def gap_point(s, h, w, cells, n, informed, sx, sy, gx, gy, c_best):
+    """One draw of the gap sampler: a uniform point of a cell drawn uniformly from the ``n``
+    gap cells (flat indices ``cells``, :mod:`.gaps`); when ``informed``, conditioned on the
+    ellipse as :func:`informed_point` conditions a heatmap draw (at most
+    :data:`HEATMAP_TRIES` draws, then a uniform point of the ellipse)."""
+    if not informed:
+        return _cell_point(s, w, cells, n)
+    for _ in range(HEATMAP_TRIES):
+        x, y = _cell_point(s, w, cells, n)
+        if in_ellipse(x, y, sx, sy, gx, gy, c_best):
+            return x, y
+    return ellipse_uniform(s, h, w, sx, sy, gx, gy, c_best)
+
+
+@njit(cache=True)
+def any_point(s, h, w, mix, cdf, last, share, cells, n, informed, sx, sy, gx, gy, c_best):
+    """One sample of a planner: with probability ``share`` (when ``n`` gap cells exist) a
+    :func:`gap_point`, else the sampler's draw (:func:`informed_point` when ``informed``,
+    else :func:`sample_point`). With ``share`` 0 no random number is spent on the choice,
+    so the draws are those of the sampler alone."""
+    if share > 0.0 and n > 0 and next_double(s) < share:
+        return gap_point(s, h, w, cells, n, informed, sx, sy, gx, gy, c_best)
+    if informed:
+        return informed_point(s, h, w, mix, cdf, last, sx, sy, gx, gy, c_best)
+    return sample_point(s, h, w, mix, cdf, last)
+
+
+@njit(cache=True)
+def _draw(s, count, h, w, mix, cdf, last, share, cells, n, informed, sx, sy, gx, gy, c_best):
+    out = np.empty((count, 2))
+    for k in range(count):
+        p = any_point(s, h, w, mix, cdf, last, share, cells, n, informed, sx, sy, gx, gy, c_best)
         out[k, 0], out[k, 1] = p
     return out
 
 
-def draw(sampler: Sampler, n: int, seed=0, ellipse=None) -> np.ndarray:
+NO_CELLS = np.zeros(1, np.int64)  # the gap-cell array of a sampler without gap draws
+
+
+def draw(sampler: Sampler, n: int, seed=0, ellipse=None, gaps=None) -> np.ndarray:
     """``n`` samples ``(n, 2)`` float64 (x, y) in pixels from ``sampler`` (for tests, plots);
     ``ellipse=(start, goal, c_best)`` draws the informed samples of a run whose best solution
-    costs ``c_best``."""
+    costs ``c_best``; ``gaps=(share, cells)`` mixes in the gap sampler's draws as a planner
+    with ``gap_share=share`` does (``cells``: flat indices, :func:`vnrrt.planners.gaps.
+    gap_cells`)."""
     h, w = sampler.shape
     cdf = sampler.cdf if sampler.cdf.size else np.zeros(1)
     (sx, sy), (gx, gy), c_best = ellipse if ellipse is not None else ((0, 0), (0, 0), 0.0)
+    share, cells = gaps if gaps is not None else (0.0, NO_CELLS)
+    cells = np.asarray(cells, np.int64)
     return _draw(
         rng_state(seed),
         int(n),
@@ -258,6 +303,9 @@ def draw(sampler: Sampler, n: int, seed=0, ellipse=None) -> np.ndarray:
         sampler.draw_mix,
         cdf,
         max(sampler.last, 0),
+        float(share),
+        cells if cells.size else NO_CELLS,
+        int(cells.size),
         ellipse is not None,
         float(sx),
         float(sy),
