@@ -22,9 +22,10 @@ after them (``--collect-before``: right before each call, the earlier method, wh
 the call's caches cold). Per map: medians over trials and the ratio of the best native OMPL
 planner's median to ours; overall: each planner's median over maps, the ratio of the best
 OMPL planner's (native, then Python) to ours, and the median and worst per-map ratio (for
-the whole call too). The floor is the exact visibility-graph solve itself, timed per map. Every path of ours is checked
-with the exact segment test and against the stop rule (exit 1 if one fails); OMPL's paths that
-clip an obstacle corner under that test are counted. Exit 2 when the harness cannot be built.
+the whole call too). The floor is the exact visibility-graph solve itself, timed per map.
+Every path of ours is checked with the exact segment test and against the stop rule (exit 1
+if one fails); OMPL's paths that clip an obstacle corner under that test are counted. Exit 2
+when the harness cannot be built. OMPL's Python bindings run with the garbage collector on.
 
     python benchmarks/bench_planners.py [--trials 5] [--time-limit 2] [--sets dev,held_out]
 """

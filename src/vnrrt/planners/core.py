@@ -42,7 +42,7 @@ from vnrrt.planners import spatial
 from vnrrt.planners.collision import segment_free
 from vnrrt.planners.gaps import gap_cells
 from vnrrt.planners.refine import AT_REST, IMPROVED, refine_step
-from vnrrt.planners.samplers import any_point, next_double
+from vnrrt.planners.samplers import NO_CELLS, any_point, next_double
 from vnrrt.planners.tree import (
     PARENT,
     Counters,
@@ -79,9 +79,6 @@ class Params(NamedTuple):
     refine: float = 0.0
     pull_parents: bool = False
     refine_branches: float = 0.0
-
-
-NO_CELLS = np.zeros(1, np.int64)  # the gap cells of a sampler without (or not yet with) any
 
 
 class Draws(NamedTuple):

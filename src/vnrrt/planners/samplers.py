@@ -39,6 +39,7 @@ from vnrrt.grid import GridError
 from vnrrt.planners.seeding import rng_state
 
 _INV_2_53 = 1.0 / 9007199254740992.0
+NO_CELLS = np.zeros(1, np.int64)  # the gap cells of a sampler without (or not yet with) any
 
 
 @njit(cache=True, inline="always")
@@ -279,9 +280,6 @@ def _draw(s, count, h, w, mix, cdf, last, share, cells, n, informed, sx, sy, gx,
         p = any_point(s, h, w, mix, cdf, last, share, cells, n, informed, sx, sy, gx, gy, c_best)
         out[k, 0], out[k, 1] = p
     return out
-
-
-NO_CELLS = np.zeros(1, np.int64)  # the gap-cell array of a sampler without gap draws
 
 
 def draw(sampler: Sampler, n: int, seed=0, ellipse=None, gaps=None) -> np.ndarray:
