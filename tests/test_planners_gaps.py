@@ -91,34 +91,51 @@ def test_gap_draws_fall_in_gap_cells_in_their_share():
 
 
 def test_informed_gap_draws_stay_in_the_ellipse():
+    """Informed: every draw in the ellipse; the slit lies in it, so the gap draws keep their
+    share (0.5 within a 5-sigma binomial bound, plus the uniform draws that land there)."""
     g = slit_map()
     cells = gap_cells(g, 8)
     start, goal, c_best = (5.5, 31.5), (55.5, 31.5), 52.0
-    pts = draw(uniform_sampler(g.shape), 3000, seed=5, ellipse=(start, goal, c_best),
+    n = 4000
+    pts = draw(uniform_sampler(g.shape), n, seed=5, ellipse=(start, goal, c_best),
                gaps=(0.5, cells))  # fmt: skip
     d = np.hypot(*(pts - start).T) + np.hypot(*(pts - goal).T)
     assert (d <= c_best + 1e-9).all()
+    flat = np.floor(pts[:, 1]).astype(int) * 60 + np.floor(pts[:, 0]).astype(int)
+    frac = np.isin(flat, cells).mean()
+    assert abs(frac - 0.5) < 5 * math.sqrt(0.25 / n) + 0.01
 
 
 def test_a_gap_sampler_that_starts_after_the_run_changes_nothing():
     """While its cells are pending the gap sampler spends no random number: a run that ends
-    before ``gap_after`` is the run without it; with ``gap_after=K`` the trace up to
-    iteration K is the same."""
+    before ``gap_after`` is the run without it, and so are the first ``gap_after``
+    iterations of a run that goes on (both stopped there by the iteration budget, against a
+    target no run meets)."""
     g = slit_map(100, 70)
     s, e = (5.5, 10.5), (94.5, 90.5)
     base = plan(g, s, e, config=NO_GAPS, stop="initial", seed=3)
     late = plan(g, s, e, config=NO_GAPS.replace(gap_share=0.5, gap_after=10**8), stop="initial",
                 seed=3)  # fmt: skip
-    for f in ("iterations", "tree_size", "collision_checks", "cost"):
-        assert getattr(base, f) == getattr(late, f), f
-    np.testing.assert_array_equal(base.path, late.path)
+    assert_same_run(base, late)
     k = base.iterations // 2
-    mid = plan(g, s, e, config=NO_GAPS.replace(gap_share=0.5, gap_after=k), stop="initial",
-               seed=3)  # fmt: skip
-    early = base.trace_iterations <= k
-    n = int(early.sum())
-    np.testing.assert_array_equal(mid.trace_iterations[:n], base.trace_iterations[early])
-    np.testing.assert_array_equal(mid.trace_costs[:n], base.trace_costs[early])
+    cut = NO_GAPS.replace(max_iterations=k)
+    a = plan(g, s, e, config=cut, stop="optimal", reference_length=1.0, seed=3)
+    b = plan(g, s, e, config=cut.replace(gap_share=0.5, gap_after=k), stop="optimal",
+             reference_length=1.0, seed=3)  # fmt: skip
+    assert a.iterations == b.iterations == k and a.stop_reason == "max_iterations"
+    assert_same_run(a, b)
+    c = plan(g, s, e, config=NO_GAPS.replace(max_iterations=k + 200, gap_share=0.5,
+             gap_after=k), stop="optimal", reference_length=1.0, seed=3)  # fmt: skip
+    assert c.tree_size != a.tree_size or c.collision_checks != a.collision_checks  # it drew
+
+
+def assert_same_run(a, b):
+    """The same tree and answer: iterations, nodes, checks, cost, path and trace."""
+    for f in ("iterations", "tree_size", "collision_checks", "cost"):
+        assert getattr(a, f) == getattr(b, f), f
+    np.testing.assert_array_equal(a.path, b.path)
+    np.testing.assert_array_equal(a.trace_iterations, b.trace_iterations)
+    np.testing.assert_array_equal(a.trace_costs, b.trace_costs)
 
 
 def test_the_gap_sampler_finds_a_slit_in_fewer_iterations():
@@ -142,7 +159,11 @@ def test_the_gap_sampler_finds_a_slit_in_fewer_iterations():
         ("gap_share", 1.5),
         ("gap_width", 0),
         ("gap_width", 2.5),
+        ("gap_width", 2**40),
         ("gap_after", -1),
+        ("gap_after", 2.5),
+        ("gap_after", True),
+        ("gap_after", 2**63),
     ],
 )
 def test_bad_gap_settings_are_named(field, value):

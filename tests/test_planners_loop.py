@@ -32,6 +32,13 @@ CASES = [
     ("rrt_star", PlannerConfig(max_iterations=9000), "unreachable", ()),  # the tree fills up
     ("rrt_star", FASTEST.replace(gap_share=0.3, gap_after=100), "optimal", (1.1,)),  # gaps
     ("vnrrt_star", PlannerConfig(gap_share=0.2, gap_width=4), "initial", ()),
+    # gaps and a tree that fills up: the compiled loop finds the cells again after enlarging
+    (
+        "rrt_star",
+        PlannerConfig(max_iterations=9000, gap_share=0.3, gap_after=100),
+        "unreachable",
+        (),
+    ),
 ]
 
 

@@ -11,7 +11,7 @@ seeding, JIT compilation (once per process, :func:`warmup`) and the reference-le
 computation (an oracle, not part of planning) are outside the timed region. With
 ``straight_first``, a free start-goal segment that meets the stop rule is the answer: the run's
 time is that one segment test (:mod:`.run`). The gap sampler's cells (``gap_share``) are found
-inside the run, at its iteration ``gap_after``.
+inside the run, after ``gap_after`` iterations.
 """
 
 from __future__ import annotations

@@ -14,7 +14,7 @@ the solution are skipped: a near node ``q`` with ``|q - start| + |q - goal| > c_
 parent or rewiring candidate, and a new node whose cost-to-come plus its straight line to the
 goal exceeds ``c_best`` is not added (no path through it can be better).
 
-**Gaps**, when ``Draws.gap_share > 0``: from iteration ``Draws.gap_after`` on, that share of
+**Gaps**, when ``Draws.gap_share > 0``: after ``Draws.gap_after`` iterations, that share of
 the samples is drawn from the map's narrow-passage cells (:mod:`.gaps`; found then, by
 :func:`with_gaps`, inside the run), inside the ellipse once informed sampling applies.
 
@@ -84,8 +84,8 @@ class Params(NamedTuple):
 class Draws(NamedTuple):
     """The sampler: heatmap draw probability ``mix``, cumulative weights ``cdf`` over flat
     pixels and the last pixel with weight (see :mod:`.samplers`); the gap sampler: its share
-    ``gap_share`` of the samples, the widest passage ``gap_width`` (cells), the iteration
-    ``gap_after`` from which it draws, and the first ``n_gaps`` flat indices of
+    ``gap_share`` of the samples, the widest passage ``gap_width`` (cells), the iterations
+    ``gap_after`` before its first draw, and the first ``n_gaps`` flat indices of
     ``gap_cells`` it draws from (:mod:`.gaps`; ``n_gaps`` -1: not found yet, 0: none)."""
 
     mix: float

@@ -2,9 +2,10 @@
 
 The bridge test (Hsu et al., 2003) samples the midpoint of a short segment whose two ends
 lie in obstacles and keeps it when it is free: a point in a narrow passage. On an occupancy
-grid the test can be made exact and run once per map instead of by rejection: a free cell
-is a **gap cell** of width ``width`` when the run of free cells through it along its row or
-along its column is at most ``width`` cells long; a run ends at an obstacle cell or at the
+grid an axis-aligned form of it can be run over every cell at once instead of by rejection
+(a passage at 45 degrees reads up to sqrt(2) wider than it is): a free cell is a **gap
+cell** of width ``width`` when the run of free cells through it along its row or along its
+column is at most ``width`` cells long; a run ends at an obstacle cell or at the
 map border (outside the map counts as obstacle, as in :mod:`.collision`). A one-cell slit
 through a wall, a 3-6 px gap, a corridor between an obstacle and the border are gap cells;
 open space, and the free cells beside a single wall, are not.
