@@ -40,17 +40,22 @@ repro: $(STAMP)  ## run the whole pipeline (dvc repro) at the default scale
 	$(BIN)/dvc repro
 
 CPU_REPORTS := reports/cpu
-# Wall time on an idle 2-core machine: ~80 min for both networks at train.seed 1 and the pipeline
-# at seed 0, plus ~75 min for the training-budget curve at seed 0 (conf/scale/cpu.yaml budget:
-# 2 networks x 9,000 steps at the 0.21-0.22 s a step of reports/cpu/metrics/train_*.json, ~64
-# min, with their tests, heatmaps, trials and report).
-repro-cpu: $(STAMP)  ## the CPU study scale (~155 min on 2 cores): both networks at train.seed 1, then the whole pipeline and the training-budget curve at seed 0; reports copied to reports/cpu/, the per-trial tables behind them to reports/cpu/results/
-	$(BIN)/dvc exp run -S scale=cpu -S train.seed=1 predict_metrics
+# The study's reports first, so that a run cut short still leaves them: the pipeline at
+# train.seed 0 (paper comparison and sampling ideas), then both networks at train.seed 1, then
+# the training-budget curve at seed 0. Wall time measured on 2026-12-02 (2-core AVX-512 machine
+# with bf16; see the README): ~38 min for the data and both trainings, ~2 min trials, ~4 min
+# oracle selection; the oracle evaluation and regime grid (regime@0, 49,980 planner runs) ran
+# 13 min for its first 40% and had slowed to ~5 runs/s (~1.5 h more) when the session ended;
+# ~37 min for seed 1's trainings; the budget curve not yet timed (estimated ~75 min).
+repro-cpu: $(STAMP)  ## the CPU study scale (over 4 h on 2 cores): the pipeline at seed 0 (reports first), both networks at train.seed 1, the training-budget curve; reports copied to reports/cpu/, the per-trial tables behind them to reports/cpu/results/
+	$(BIN)/dvc exp run -S scale=cpu ideas report
 	rm -rf $(CPU_REPORTS) && mkdir -p $(CPU_REPORTS)/seed1
+	cp -r reports/paper_comparison.md reports/sampling_ideas.md reports/metrics reports/figures $(CPU_REPORTS)/
+	$(BIN)/python -m vnrrt.evaluation.recompute export --params params.yaml --out $(CPU_REPORTS)/results
+	$(BIN)/dvc exp run -S scale=cpu -S train.seed=1 predict_metrics
 	cp reports/metrics/train_*.json reports/metrics/predict.json $(CPU_REPORTS)/seed1/
 	$(BIN)/dvc exp run -S scale=cpu
-	cp -r reports/paper_comparison.md reports/sampling_ideas.md reports/training_budget.md reports/metrics reports/figures $(CPU_REPORTS)/
-	$(BIN)/python -m vnrrt.evaluation.recompute export --params params.yaml --out $(CPU_REPORTS)/results
+	cp -r reports/training_budget.md reports/metrics reports/figures $(CPU_REPORTS)/
 
 repro-cpu-budget-seed1: $(STAMP)  ## after repro-cpu: the training-budget curve at train.seed 1 (~75 min on 2 cores); to reports/cpu/seed1/
 	$(BIN)/dvc exp run -S scale=cpu -S train.seed=1 budget_report@training_budget
