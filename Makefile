@@ -44,10 +44,10 @@ CPU_REPORTS := reports/cpu
 # train.seed 0 (paper comparison and sampling ideas), then both networks at train.seed 1, then
 # the training-budget curve at seed 0. Wall time measured on 2026-12-02 (2-core AVX-512 machine
 # with bf16; see the README): ~38 min for the data and both trainings, ~2 min trials, ~4 min
-# oracle selection; the oracle evaluation and regime grid (regime@0, 49,980 planner runs) ran
-# 13 min for its first 40% and had slowed to ~5 runs/s (~1.5 h more) when the session ended;
-# ~37 min for seed 1's trainings; the budget curve not yet timed (estimated ~75 min).
-repro-cpu: $(STAMP)  ## the CPU study scale (over 4 h on 2 cores): the pipeline at seed 0 (reports first), both networks at train.seed 1, the training-budget curve; reports copied to reports/cpu/, the per-trial tables behind them to reports/cpu/results/
+# oracle selection, ~26 min the oracle evaluation and regime grid (regime@0, 49,980 jobs of 2
+# planner runs), ~3 min the reports; ~37 min for seed 1's trainings; the budget curve not yet
+# timed (estimated ~75 min).
+repro-cpu: $(STAMP)  ## the CPU study scale (about 3 h on 2 cores): the pipeline at seed 0 (reports first), both networks at train.seed 1, the training-budget curve; reports copied to reports/cpu/, the per-trial tables behind them to reports/cpu/results/
 	$(BIN)/dvc exp run -S scale=cpu ideas report
 	rm -rf $(CPU_REPORTS) && mkdir -p $(CPU_REPORTS)/seed1
 	cp -r reports/paper_comparison.md reports/sampling_ideas.md reports/metrics reports/figures $(CPU_REPORTS)/

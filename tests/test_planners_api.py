@@ -288,12 +288,57 @@ def test_a_planner_set_up_once_answers_as_plan_does(grid, heat, planner):
     per seed, exactly what a plan() call gives."""
     kw = kwargs_for(planner, heat, straight_first=True, informed=True)
     once = Planner(grid, planner, **kw)
-    for seed, (s, e) in enumerate([(START, GOAL), (GOAL, START), ((10.5, 10.5), (15.5, 12.5))]):
-        a = once.solve(s, e, stop="optimal", seed=seed)
-        b = plan(grid, s, e, planner, stop="optimal", seed=seed, **kw)
-        assert (a.cost, a.iterations, a.tree_size, a.collision_checks) == (
-            b.cost, b.iterations, b.tree_size, b.collision_checks)  # fmt: skip
-        np.testing.assert_array_equal(a.path, b.path)
+    queries = [(START, GOAL), (GOAL, START), ((10.5, 10.5), (15.5, 12.5))]  # the last: free
+    for seed, ((s, e), keep) in enumerate(itertools.product(queries, (False, True))):
+        ask = {"stop": "optimal", "seed": seed, "milestones": (20.0, 400.0), "keep_tree": keep}
+        a, b = once.solve(s, e, **ask), plan(grid, s, e, planner, **ask, **kw)
+        assert same_run(a, b)
+
+
+TIMES = ("time_to_first", "time_to_stop", "setup_time", "milestones")
+
+
+def same_run(a, b) -> bool:
+    """Two results of one query and seed agree on every field that is not a time (and on
+    which milestones were reached, at which iteration)."""
+    for name in a.__dataclass_fields__:
+        x, y = getattr(a, name), getattr(b, name)
+        if name in TIMES:
+            continue
+        if isinstance(x, np.ndarray) or isinstance(y, np.ndarray):
+            np.testing.assert_array_equal(x, y, err_msg=name)
+        else:
+            assert x == y, name
+    reached = [(m.bound, m.iteration) for m in a.milestones]
+    return reached == [(m.bound, m.iteration) for m in b.milestones]
+
+
+@pytest.mark.parametrize(
+    ("args", "kwargs", "error", "match"),
+    [
+        (((99.5, 50.5), (15.5, 12.5)), {}, GridError, "obstacle"),
+        (((0.0, 12.5), (15.5, 12.5)), {}, GridError, "border"),
+        (((10.5, 10.5), (15.5, float("inf"))), {}, GridError, "finite"),
+        (((10.5, 10.5), (15.5, 12.5)), {"stop": "best"}, ValueError, "stop rule"),
+        (((10.5, 10.5), (15.5, 12.5)), {"seed": -1}, ValueError, "seed"),
+        (((10.5, 10.5), (15.5, 12.5)), {"milestones": ("a",)}, ValueError, "a"),
+        (
+            ((10.5, 10.5), (15.5, 12.5)),
+            {"stop": "optimal", "reference_length": -1.0},
+            ValueError,
+            "reference_length",
+        ),
+    ],
+)
+def test_a_free_segment_is_answered_only_after_the_checks_of_a_search(grid, args, kwargs,
+                                                                       error, match):  # fmt: skip
+    """plan()'s RRT* answer to a free straight segment (no Planner built) refuses what
+    Planner.solve refuses."""
+    cfg = PlannerConfig(straight_first=True)
+    with pytest.raises(error, match=match):
+        plan(grid, *args, config=cfg, **kwargs)
+    with pytest.raises(error, match=match):
+        Planner(grid, config=cfg).solve(*args, **kwargs)
 
 
 def test_one_shot_plans_reuse_a_pooled_tree_and_give_the_same_results(grid, monkeypatch):

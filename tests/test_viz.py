@@ -175,14 +175,16 @@ def test_convergence_grid_names_ms_log_axes_with_labels_and_one_legend():
 def test_quality_curve_one_panel_per_stop_with_networks_as_stars():
     rows = []
     for stop in ("optimal", "optimal_any_angle"):
-        for idea, conf in (("path", "nrrt_star"), ("vertex", "vnrrt_star")):
+        members = (("path", "nrrt_star", True), ("vertex", "vnrrt_star", True),
+                   ("path", "nrrt_star~0.5", False))  # the last: another stop rule's  # fmt: skip
+        for idea, member, own in members:
             for q, x in ((1.0, 30.0), (0.1, 4.0), (0.0, 1.0)):  # mass x a uniform map's
                 s = 1 + x / 3
-                rows.append((stop, idea, conf, q, x, "iterations", s, s * 0.9, s * 1.1))
-    curves = pd.DataFrame(
-        rows,
-        columns=["stop", "idea", "configuration", "q", "x_uniform", "metric", *SPEEDUP],
-    )
+                conf = f"{member}@q{q:g}"  # stands for the diluted envelope's key text
+                rows.append((stop, idea, conf, member, own, q, x, "iterations", s, s * 0.9,
+                             s * 1.1))  # fmt: skip
+    columns = ["stop", "idea", "configuration", "member", "own", "q", "x_uniform", "metric"]
+    curves = pd.DataFrame(rows, columns=[*columns, *SPEEDUP])
     nets = pd.DataFrame(
         [
             ("optimal", "vnrrt_star[vertexnet]", "iterations", 2.5, 1.3, 1.1, 1.5),
@@ -201,11 +203,14 @@ def test_quality_curve_one_panel_per_stop_with_networks_as_stars():
         assert ax.get_xscale() == ax.get_yscale() == "log"
         assert "mass within 2 px" in ax.get_xlabel() and "x a uniform map's" in ax.get_xlabel()
     assert "speed-up over RRT*" in panels[0].get_ylabel()
-    (legend,) = fig.legends
-    assert [t.get_text() for t in legend.get_texts()] == [
-        "NRRT*, path envelope",
-        "VNRRT*, vertex envelope",
-    ]
+    for ax in panels:  # one curve per envelope of the panel's own stop rule, its q joined
+        assert [t.get_text() for t in ax.get_legend().get_texts()] == [
+            "NRRT*, path envelope",
+            "VNRRT*, vertex envelope",
+        ]
+        drawn = [line for line in ax.get_lines() if line.get_marker() == "o"]
+        assert [len(line.get_xdata()) for line in drawn] == [3, 3]
+        assert [line.get_color() for line in drawn] == ["C0", "C1"]  # path, vertex
     stars = [line for line in panels[0].get_lines() if line.get_marker() == "*"]
     # the informed network is not placed on curves of plain samplers
     assert [(s.get_xdata()[0], s.get_ydata()[0]) for s in stars] == [(2.5, 1.3), (2.5, 1.31)]
@@ -224,6 +229,7 @@ def test_regime_heatmap_cells_colour_bar_and_significance_marks():
             ("eta=5", "vnrrt_star", 0.5, 0.3, 0.9),
             ("eta=20", "nrrt_star", 2.0, 0.9, 3.0),
             ("eta=20", "vnrrt_star", 1.0, 0.8, 1.3),
+            ("eta=20", "vnrrt_star@q0.5", 1.1, 0.8, 1.3),  # one cell's extra: not a column
         ],
         columns=["regime", "configuration", "speedup", "ci_low", "ci_high"],
     ).assign(stop="optimal")

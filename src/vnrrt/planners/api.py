@@ -137,6 +137,35 @@ def _seed(seed) -> None:
         raise ValueError(f"seed must be an int >= 0 or a tuple of them, got {seed!r}")
 
 
+def _logged(result: PlanResult) -> PlanResult:
+    """``result``, its summary logged at DEBUG level."""
+    if log.isEnabledFor(logging.DEBUG):
+        log.debug("%s", result.summary())
+    return result
+
+
+def _query(occ: np.ndarray, cfg: PlannerConfig, start, goal, stop: str, reference_length,
+           seed, milestones, keep_tree: bool, setup_time: float = 0.0,
+           fallback: bool = False) -> run.Query:  # fmt: skip
+    """The validated query of a solve (arguments and errors: :meth:`Planner.solve`), the
+    compiled kernels loaded (:func:`warmup`)."""
+    start, goal = _endpoints(occ, start, goal)
+    if stop not in ("initial", "optimal"):
+        raise ValueError(f"unknown stop rule {stop!r}; use 'initial' or 'optimal'")
+    _seed(seed)
+    if reference_length is None and stop == "optimal":
+        reference_length = compute_reference(occ, start, goal, cfg.reference)
+    if reference_length is not None and not (
+        math.isfinite(reference_length) and reference_length >= 0
+    ):
+        raise ValueError(f"reference_length must be finite and >= 0, got {reference_length}")
+    target = None if stop == "initial" else (1.0 + cfg.eps) * reference_length
+    bounds = tuple(float(m) for m in milestones) if milestones else ()
+    warmup()
+    return run.Query(start, goal, target, bounds, keep_tree, reference_length, setup_time,
+                     fallback)  # fmt: skip
+
+
 class Planner:
     """One of the paper's RRT* variants set up for one map, as OMPL's ``setup()``: the grid
     validated, the sampler built and the settings checked once; :meth:`solve` answers a
@@ -241,36 +270,26 @@ class Planner:
             NoPathError: the A* reference is needed and start and goal are not connected.
             ValueError: unknown stop rule, bad reference length or seed.
         """
-        start, goal = _endpoints(self.occ, start, goal)
-        if stop not in ("initial", "optimal"):
-            raise ValueError(f"unknown stop rule {stop!r}; use 'initial' or 'optimal'")
-        _seed(seed)
-        cfg = self.config
-        if reference_length is None and stop == "optimal":
-            reference_length = compute_reference(self.occ, start, goal, cfg.reference)
-        if reference_length is not None and not (
-            math.isfinite(reference_length) and reference_length >= 0
-        ):
-            raise ValueError(f"reference_length must be finite and >= 0, got {reference_length}")
-        target = None if stop == "initial" else (1.0 + cfg.eps) * reference_length
-        bounds = tuple(float(m) for m in milestones) if milestones else ()
-        query = run.Query(start, goal, target, bounds, keep_tree, reference_length,
-                          self.setup_time, self.sampler.fallback_uniform)  # fmt: skip
-        warmup()
-        result = self._run(query, seed)
-        if log.isEnabledFor(logging.DEBUG):
-            log.debug("%s", result.summary())
-        return result
+        ask = (stop, reference_length, seed, milestones, keep_tree)
+        query = _query(self.occ, self.config, start, goal, *ask, self.setup_time,
+                       self.sampler.fallback_uniform)  # fmt: skip
+        return self._run(query, seed)
 
-    def _run(self, query: run.Query, seed) -> PlanResult:
-        """The timed run of a validated query (:mod:`.run`)."""
-        d, spent = run.straight_test(self.occ, query) if self.config.straight_first else (
-            -1.0, 0.0)  # fmt: skip
+    def _run(self, query: run.Query, seed, tested: tuple[float, float] | None = None) -> PlanResult:
+        """The timed run of a validated query (:mod:`.run`); ``tested``: the straight
+        segment's test already made (:func:`run.straight_test`), when it was."""
+        if tested is None:
+            tested = run.straight_test(self.occ, query) if self.config.straight_first else (
+                -1.0, 0.0)  # fmt: skip
+        d, spent = tested
         if d >= 0 and (query.target is None or d <= query.target):
-            return run.straight_result(self.planner, query, d, spent)
-        return run.search(self.occ, query, planner=self.planner, params=self._params(query),
-                          draws=self.draws, rng=rng_state(seed), work=self._work,
-                          straight=d >= 0, spent=spent)  # fmt: skip
+            result = run.straight_result(self.planner, query, d, spent)
+        else:
+            result = run.search(self.occ, query, planner=self.planner,
+                                params=self._params(query), draws=self.draws,
+                                rng=rng_state(seed), work=self._work, straight=d >= 0,
+                                spent=spent)  # fmt: skip
+        return _logged(result)
 
     def _params(self, query: run.Query) -> core.Params:
         """The core's settings of a run (:class:`vnrrt.planners.core.Params`)."""
@@ -317,12 +336,27 @@ def plan(
     :class:`PlannerConfig`; :data:`FASTEST` our fastest); ``stop`` ``'initial'`` or
     ``'optimal'`` (cost <= (1 + eps) x ``reference_length``, None: ``config.reference``
     computed); ``seed`` an int >= 0 or a tuple of them. Arguments and errors: :class:`Planner`
-    and :meth:`Planner.solve`. Returns a :class:`PlanResult`."""
+    and :meth:`Planner.solve`. Returns a :class:`PlanResult`. RRT* with ``straight_first``
+    answers a free straight segment that meets the stop rule without building the
+    :class:`Planner` (the same result, without its setup's microseconds)."""
+    ask = (stop, reference_length, seed, milestones, keep_tree)
+    query = tested = None
+    if planner == "rrt_star" and heatmap is None and sampler is None:
+        config = _config(config)  # uniform sampling: the free segment needs no Planner
+        if config.straight_first:
+            grid = _occupancy(grid)
+            query = _query(grid, config, start, goal, *ask)
+            tested = run.straight_test(grid, query)
+            d = tested[0]
+            if d >= 0 and (query.target is None or d <= query.target):
+                return _logged(run.straight_result(planner, query, d, tested[1]))
     p = Planner(grid, planner, heatmap=heatmap, config=config, sampler=sampler)
     p._pooled = True  # a one-shot planner: its tree's arrays are reused by the next plan()
     try:
-        return p.solve(start, goal, stop=stop, reference_length=reference_length, seed=seed,
-                       milestones=milestones, keep_tree=keep_tree)  # fmt: skip
+        if query is None:
+            return p.solve(start, goal, stop=stop, reference_length=reference_length, seed=seed,
+                           milestones=milestones, keep_tree=keep_tree)  # fmt: skip
+        return p._run(query._replace(setup_time=p.setup_time), seed, tested)
     finally:
         if "_work" in p.__dict__:  # a tree was made (not for a free straight segment)
             p._work.release()

@@ -178,7 +178,11 @@ def straight_result(planner: str, query: Query, d: float, found: float) -> PlanR
     length ``d``: the tree is the root and the goal joined to it (one segment test). The
     cost is ``d``, equal to the polyline length of the path (both are libm's ``hypot``)."""
     path = np.array((query.start, query.goal))
-    extra = tuple(Milestone(b, found, 0) if d <= b else Milestone(b) for b in query.bounds)
+    extra = (
+        tuple(Milestone(b, found, 0) if d <= b else Milestone(b) for b in query.bounds)
+        if query.bounds
+        else ()
+    )
     return PlanResult.of({
         "planner": planner,
         "success": True,

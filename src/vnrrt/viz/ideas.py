@@ -10,12 +10,14 @@ import numpy as np
 import pandas as pd
 
 from vnrrt.evaluation.keys import is_informed, label
+from vnrrt.evaluation.sampling_ideas.summary import sweep_columns
 from vnrrt.names import level_name, stop_name
 from vnrrt.viz.common import log_ticks, save_figure
 
 QUALITY_STOPS = ("initial", "optimal", "optimal_any_angle")
 
 IDEA_NAMES = {"path": "path envelope", "vertex": "vertex envelope"}
+IDEA_COLORS = {"path": "C0", "vertex": "C1"}  # the same idea, the same colour in every panel
 
 
 def quality_figure(
@@ -23,15 +25,16 @@ def quality_figure(
 ):
     """Speed-up over RRT* (log axis, whiskers: CI) against the heatmap's mass near its
     target in multiples of a uniform map's (``x_uniform``), one curve per idea's envelope
-    (points: signal fractions q), one panel per stop rule; the trained networks as labelled
-    stars at their own measured mass. ``settings``: the study's ``eps``, ``level`` and mass
-    ``radius`` (px), named on the figure. Returns it."""
+    chosen for the panel's stop rule (rows with ``own``; points: signal fractions q of its
+    ``member``; one colour per idea, a legend per panel), one panel per stop rule; the
+    trained networks as labelled stars at their own measured mass. ``settings``: the
+    study's ``eps``, ``level`` and mass ``radius`` (px), named on the figure. Returns it."""
     eps = settings["eps"]
     stops = [s for s in QUALITY_STOPS if s in set(curves["stop"])]
     fig, axes = plt.subplots(1, len(stops), figsize=(4.6 * len(stops), 4.2), squeeze=False)
     for ax, stop in zip(axes[0], stops, strict=True):
-        sub = curves[(curves["stop"] == stop) & (curves["metric"] == metric)]
-        for (idea, conf), rows in sub.groupby(["idea", "configuration"], sort=False):
+        sub = curves[(curves["stop"] == stop) & (curves["metric"] == metric) & curves["own"]]
+        for (idea, conf), rows in sub.groupby(["idea", "member"], sort=False):
             rows = rows.dropna(subset=["x_uniform"]).sort_values("x_uniform")
             err = [rows["speedup"] - rows["ci_low"], rows["ci_high"] - rows["speedup"]]
             name = f"{label(conf)}, {IDEA_NAMES.get(idea, idea)}"
@@ -43,6 +46,7 @@ def quality_figure(
                 ms=3,
                 capsize=2,
                 label=name,
+                color=IDEA_COLORS.get(idea),
             )
         nets = (
             networks
@@ -71,27 +75,29 @@ def quality_figure(
             f"heatmap mass within {settings['radius']:g} px of its target (x a uniform map's)"
         )
         ax.set_title(stop_name(stop, eps), fontsize=9)
+        if ax.get_legend_handles_labels()[0]:  # each stop rule has envelopes of its own
+            ax.legend(loc="upper left", fontsize=6)
     axes[0, 0].set_ylabel(f"speed-up over RRT* ({metric.replace('time_to_stop', 'time')})")
-    handles, labels = axes[0, 0].get_legend_handles_labels()
-    fig.legend(handles, labels, loc="lower center", ncol=3, fontsize=7, bbox_to_anchor=(0.5, -0.08))
     fig.suptitle(
         "How good must a heatmap be? Speed-up against heatmap quality "
         "(points: signal fraction q; stars: the trained networks; whiskers: "
         f"{level_name(settings['level'])} CI)",
         fontsize=9,
     )
-    fig.tight_layout(rect=(0, 0.05, 1, 1))
+    fig.tight_layout()
     return fig
 
 
 def regime_figure(cells: pd.DataFrame, stop: str, settings: dict):
-    """Speed-up over RRT* per regime cell (rows) and configuration (columns), log colour
+    """Speed-up over RRT* per regime cell (rows) and configuration run in every cell
+    (columns, :func:`vnrrt.evaluation.sampling_ideas.summary.sweep_columns`), log colour
     scale, ``*`` where the CI excludes 1; ``settings``: the study's ``eps`` and ``level``.
     Returns the figure."""
     eps = settings["eps"]
     sub = cells[cells["stop"] == stop]
     regimes = list(dict.fromkeys(sub["regime"]))
-    confs = list(dict.fromkeys(sub["configuration"]))
+    confs = sweep_columns(sub.to_dict("records"))
+    sub = sub[sub["configuration"].isin(confs)]
     grid = np.full((len(regimes), len(confs)), np.nan)
     sig = np.zeros_like(grid, bool)
     for _, r in sub.iterrows():

@@ -11,6 +11,7 @@ import math
 
 from vnrrt.evaluation.keys import ConfigKey, label
 from vnrrt.evaluation.sampling_ideas.design import PROTOCOL
+from vnrrt.evaluation.sampling_ideas.summary import sweep_columns
 from vnrrt.names import level_name, percent, stop_name
 
 IDEAS = ("path", "vertex", "blend", "control")
@@ -74,12 +75,80 @@ def _envelope_findings(summary: dict, stop: str, eps: float) -> list[str]:
     return out
 
 
+def cells_by_winner(summary: dict, stop: str, idea: str = "vertex") -> dict[str, list[str]]:
+    """``{"path": cells, idea: cells, "unclear": cells}``: the regime cells (in the study's
+    order) where the path envelope needs clearly fewer iterations than the ``idea`` envelope
+    (their paired ratio's CI below 1), where ``idea``'s needs clearly fewer (CI above 1), and
+    the others."""
+    out: dict[str, list[str]] = {"path": [], idea: [], "unclear": []}
+    rows = {
+        r["regime"]: r["iterations"]
+        for r in summary["envelopes"]
+        if r["stop"] == stop and r["idea"] == idea
+    }
+    for cell in summary["cell_names"]:
+        if cell in rows:
+            out[_word(rows[cell], idea, "path", "unclear")].append(cell)
+    return out
+
+
+def _winner_finding(summary: dict, stop: str, eps: float) -> list[str]:
+    won = cells_by_winner(summary, stop)
+    n = sum(len(v) for v in won.values())
+    if not n:
+        return []
+
+    def named(cells: list[str]) -> str:
+        return f" ({'; '.join(cells)})" if cells else ""
+
+    return [
+        f"Path envelope against vertex envelope, per regime cell ({stop_name(stop, eps)}): "
+        f"the path envelope needs clearly fewer iterations in {len(won['path'])} of {n} "
+        f"cells{named(won['path'])}; the vertex envelope in {len(won['vertex'])}"
+        f"{named(won['vertex'])}; no clear difference in {len(won['unclear'])}."
+    ]
+
+
+def censored_cells(summary: dict, stop: str) -> list[tuple[str, float, float, str]]:
+    """``(cell, RRT*'s share, the lowest share, its configuration)`` for every regime cell
+    where some runs did not reach ``stop`` within the planner's budget, in the study's
+    order."""
+    out = []
+    for cell in summary["cell_names"]:
+        rows = [r for r in summary["cells"] if r["regime"] == cell and r["stop"] == stop]
+        low = min(rows, key=lambda r: r["success_rate"], default=None)
+        if low is None or low["success_rate"] >= 1.0:
+            continue
+        base = next((r for r in rows if r["configuration"] == "rrt_star"), None)
+        rrt = base["success_rate"] if base else math.nan
+        out.append((cell, rrt, low["success_rate"], low["configuration"]))
+    return out
+
+
+def budget_table(summary: dict, stop: str) -> str:
+    """The cells with runs stopped by the budget (:func:`censored_cells`)."""
+    rows = censored_cells(summary, stop)
+    if not rows:
+        return "Every run of every cell reached the stop rule within the budget."
+    lines = [
+        "Runs that reached the stop rule within the budget, where some did not (the others "
+        "enter the statistics at the budget, censored: RRT*'s censored runs make a speed-up a "
+        "lower bound, the planner's an upper bound):",
+        "",
+        "| cell | RRT* | lowest | its configuration |",
+        "| --- | --- | --- | --- |",
+    ]
+    lines += [f"| {c} | {_pct(r)} | {_pct(lo)} | {label(k)} |" for c, r, lo, k in rows]
+    return "\n".join(lines)
+
+
 def conclusion(summary: dict) -> list[str]:
     """Plain-language findings computed from the summary (module doc)."""
     st, out = summary["settings"], []
     eps = st["eps"]
     for stop in OPTIMAL_STOPS:
         out += _envelope_findings(summary, stop, eps)
+        out += _winner_finding(summary, stop, eps)
         w0 = summary["w0"].get(stop)
         if w0:
             out.append(
@@ -126,7 +195,10 @@ def quality_needed(summary: dict, eps: float) -> list[str]:
         rows = [
             r
             for r in summary["curves"]
-            if r["idea"] == idea and r["stop"] == "optimal" and r["metric"] == "iterations"
+            if r["idea"] == idea
+            and r["stop"] == "optimal"
+            and r["metric"] == "iterations"
+            and r["own"]
         ]
         if not rows:
             continue
@@ -146,7 +218,7 @@ def quality_needed(summary: dict, eps: float) -> list[str]:
         )
         out.append(
             f"Heatmap quality the {idea} idea needs for a clear gain over RRT* in "
-            f"iterations ({stop_name('optimal', eps)}): {said}."
+            f"iterations ({stop_name('optimal', eps)}; its envelope diluted): {said}."
         )
     return out
 
@@ -203,18 +275,23 @@ def blend_table(summary: dict, stop: str) -> str:
 
 
 def quality_table(summary: dict, stop: str) -> str:
-    """The quality curve: per idea and q, the heatmap's mass near the target (x uniform)
-    and the iteration speed-up over RRT*."""
+    """The quality curve: per idea, envelope diluted (every stop rule's, ``*`` marking this
+    stop rule's own) and q, the heatmap's mass near the target (x uniform) and the iteration
+    speed-up over RRT*."""
     rows = [r for r in summary["curves"] if r["stop"] == stop and r["metric"] == "iterations"]
     if not rows:
         return "(not run)"
     lines = [
-        "| idea | q | mass near target | x a uniform map's | speed-up, iterations |",
-        "| --- | --- | --- | --- | --- |",
+        "| idea | envelope diluted | q | mass near target | x a uniform map's | "
+        "speed-up, iterations |",
+        "| --- | --- | --- | --- | --- | --- |",
     ]
-    for r in sorted(rows, key=lambda r: (r["idea"], -r["q"])):
+    for r in sorted(rows, key=lambda r: (r["idea"], not r["own"], r["member"], -r["q"])):
         x = "—" if r["x_uniform"] is None else f"{r['x_uniform']:.1f}x"
-        lines.append(f"| {r['idea']} | {r['q']:g} | {_pct(r['heat_mass'])} | {x} | {_x(r)} |")
+        name = label(r["member"]) + (" *" if r["own"] else "")
+        lines.append(
+            f"| {r['idea']} | {name} | {r['q']:g} | {_pct(r['heat_mass'])} | {x} | {_x(r)} |"
+        )
     return "\n".join(lines)
 
 
@@ -242,11 +319,12 @@ def rule_table(summary: dict, stop: str) -> str:
 
 
 def regime_section(summary: dict, stop: str) -> str:
-    """Time speed-up over RRT* per cell (rows) and configuration (columns)."""
+    """Time speed-up over RRT* per cell (rows) and configuration run in every cell
+    (columns, :func:`.summary.sweep_columns`)."""
     rows = [r for r in summary["regime"] if r["stop"] == stop]
     if not rows:
         return "(not run)"
-    confs = list(dict.fromkeys(r["configuration"] for r in rows))
+    confs = sweep_columns(rows)
     lines = [
         "| cell | " + " | ".join(label(c) for c in confs) + " |",
         "|" + " --- |" * (len(confs) + 1),
@@ -318,7 +396,9 @@ def build_ideas_report(summary: dict, scale: str, figures: list[str]) -> str:
         "## The heatmap-quality curve",
         "",
         "Each path and vertex envelope diluted "
-        "towards a uniform map (signal fraction q), in the protocol's cell.",
+        "towards a uniform map (signal fraction q), in the protocol's cell; every stop rule's "
+        "envelopes are run under each stop rule, * marks the stop rule's own (the figure shows "
+        "only those, and the conclusion reads only those).",
         "",
     ]
     for stop in OPTIMAL_STOPS:
@@ -333,5 +413,6 @@ def build_ideas_report(summary: dict, scale: str, figures: list[str]) -> str:
     ]
     for stop in OPTIMAL_STOPS:
         parts += ["", f"### {stop_name(stop, eps)}", "", regime_section(summary, stop)]
+        parts += ["", budget_table(summary, stop)]
     parts += [""] + [f"![regime]({f})" for f in figures if "regime" in f] + [""]
     return "\n".join(parts) + "\n"

@@ -143,9 +143,11 @@ def network_rows(table: pd.DataFrame, envelopes: dict, targets: dict, boot: tupl
     return out
 
 
-def quality_rows(cells: list[dict], families: dict) -> list[dict]:
+def quality_rows(cells: list[dict], families: dict, envelopes: dict) -> list[dict]:
     """The quality curve: the protocol cell's diluted envelopes, x = heatmap mass near the
-    target in multiples of a uniform map's."""
+    target in multiples of a uniform map's; ``member``: the envelope diluted (signal fraction
+    1), ``own``: it is the envelope chosen for the row's stop rule (``envelopes``: ``{stop:
+    {idea: key text}}``; the others are every other stop rule's, run under this one)."""
     out = []
     for r in cells:
         key = ConfigKey.parse(r["configuration"])
@@ -153,6 +155,8 @@ def quality_rows(cells: list[dict], families: dict) -> list[dict]:
         if r["regime"] != d.PROTOCOL or idea not in d.QUALITY_IDEAS or key.free:
             continue
         q = OracleSource.parse(key.source).q
+        member = d.diluted(key, 1.0).text
+        own = envelopes.get(r["stop"], {}).get(idea) == member
         x = r["heat_mass"] / r["uniform_mass"] if r["heat_mass"] and r["uniform_mass"] else None
         for m in METRICS:
             if m in r:
@@ -161,6 +165,8 @@ def quality_rows(cells: list[dict], families: dict) -> list[dict]:
                         "stop": r["stop"],
                         "idea": idea,
                         "configuration": r["configuration"],
+                        "member": member,
+                        "own": own,
                         "q": q,
                         "heat_mass": r["heat_mass"],
                         "uniform_mass": r["uniform_mass"],
@@ -170,6 +176,18 @@ def quality_rows(cells: list[dict], families: dict) -> list[dict]:
                     }
                 )
     return out
+
+
+def sweep_columns(rows: list[dict]) -> list[str]:
+    """The configurations of ``rows`` (dicts with ``regime`` and ``configuration``) run in
+    every cell, in first-seen order: the regime sweep's, without the protocol cell's extra
+    ones (the quality curve's and the other obstacle rule's, shown in sections of their
+    own); all of them when there is one cell."""
+    by: dict[str, set] = {}
+    for r in rows:
+        by.setdefault(r["configuration"], set()).add(r["regime"])
+    cells = set().union(*by.values()) if by else set()
+    return [c for c, seen in by.items() if seen == cells]
 
 
 def flat(cells: list[dict], metric: str) -> list[dict]:
@@ -255,7 +273,7 @@ def analyze_study(tables: dict, study: dict, pairs: list[tuple[str, str]], setti
         "blend": blends,
         "w0": w0_answer(blends),
         "networks": network_rows(ev, envelopes, study.get("targets", {}), boot) if len(ev) else [],
-        "curves": quality_rows(cells, oc.families),
+        "curves": quality_rows(cells, oc.families, envelopes),
         "regime": flat(cells, "time_to_stop"),
         "placed": placed(cells),
         "regime_claims": regime_claims(cells, pairs, ev, boot) if len(ev) else [],
