@@ -45,8 +45,8 @@ CPU_REPORTS := reports/cpu
 # the training-budget curve at seed 0. Wall time measured on 2026-12-02 (2-core AVX-512 machine
 # with bf16; see the README): ~38 min for the data and both trainings, ~2 min trials, ~4 min
 # oracle selection, ~26 min the oracle evaluation and regime grid (regime@0, 49,980 jobs of 2
-# planner runs), ~3 min the reports; ~37 min for seed 1's trainings; the budget curve not yet
-# timed (estimated ~75 min).
+# planner runs), ~3 min the reports; ~37 min for seed 1's trainings; ~63 min the budget
+# curve.
 repro-cpu: $(STAMP)  ## the CPU study scale (about 3 h on 2 cores): the pipeline at seed 0 (reports first), both networks at train.seed 1, the training-budget curve; reports copied to reports/cpu/, the per-trial tables behind them to reports/cpu/results/
 	$(BIN)/dvc exp run -S scale=cpu ideas report
 	rm -rf $(CPU_REPORTS) && mkdir -p $(CPU_REPORTS)/seed1
