@@ -321,7 +321,7 @@ def same_run(a, b) -> bool:
         (((10.5, 10.5), (15.5, float("inf"))), {}, GridError, "finite"),
         (((10.5, 10.5), (15.5, 12.5)), {"stop": "best"}, ValueError, "stop rule"),
         (((10.5, 10.5), (15.5, 12.5)), {"seed": -1}, ValueError, "seed"),
-        (((10.5, 10.5), (15.5, 12.5)), {"milestones": ("a",)}, ValueError, "a"),
+        (((10.5, 10.5), (15.5, 12.5)), {"milestones": ("a",)}, ValueError, "could not convert"),
         (
             ((10.5, 10.5), (15.5, 12.5)),
             {"stop": "optimal", "reference_length": -1.0},

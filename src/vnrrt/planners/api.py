@@ -281,10 +281,9 @@ class Planner:
         if tested is None:
             tested = run.straight_test(self.occ, query) if self.config.straight_first else (
                 -1.0, 0.0)  # fmt: skip
-        d, spent = tested
-        if d >= 0 and (query.target is None or d <= query.target):
-            result = run.straight_result(self.planner, query, d, spent)
-        else:
+        result = run.straight_answer(self.planner, query, tested)
+        if result is None:
+            d, spent = tested
             result = run.search(self.occ, query, planner=self.planner,
                                 params=self._params(query), draws=self.draws,
                                 rng=rng_state(seed), work=self._work, straight=d >= 0,
@@ -347,9 +346,9 @@ def plan(
             grid = _occupancy(grid)
             query = _query(grid, config, start, goal, *ask)
             tested = run.straight_test(grid, query)
-            d = tested[0]
-            if d >= 0 and (query.target is None or d <= query.target):
-                return _logged(run.straight_result(planner, query, d, tested[1]))
+            answer = run.straight_answer(planner, query, tested)
+            if answer is not None:
+                return _logged(answer)
     p = Planner(grid, planner, heatmap=heatmap, config=config, sampler=sampler)
     p._pooled = True  # a one-shot planner: its tree's arrays are reused by the next plan()
     try:

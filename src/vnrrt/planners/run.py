@@ -173,6 +173,16 @@ def straight_test(occ: np.ndarray, query: Query) -> tuple[float, float]:
     return d, time.perf_counter() - t0
 
 
+def straight_answer(planner: str, query: Query, tested: tuple[float, float]) -> PlanResult | None:
+    """The run's result when the straight segment ``tested`` (:func:`straight_test`: its
+    length, -1 when blocked, and the seconds taken) meets the query's stop rule, else None
+    (a tree is needed)."""
+    d, found = tested
+    if d >= 0 and (query.target is None or d <= query.target):
+        return straight_result(planner, query, d, found)
+    return None
+
+
 def straight_result(planner: str, query: Query, d: float, found: float) -> PlanResult:
     """The result of a run answered after ``found`` seconds by the free straight segment of
     length ``d``: the tree is the root and the goal joined to it (one segment test). The
