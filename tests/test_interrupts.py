@@ -63,3 +63,47 @@ def test_a_signal_ends_a_shard_stage_within_seconds_and_leaves_nothing(tmp_path,
     assert group_alive(proc.pid) == [], "processes survived the stage"
     shards = work / cfg.paths.shards
     assert not (shards / "shard_0.npz").exists() and not list(shards.glob("*.tmp-*"))
+
+
+SLOW_START = """
+import multiprocessing.process as mpp, time
+from vnrrt.parallel import parallel_map
+
+start = mpp.BaseProcess.start
+
+
+def slow_start(self):  # a worker forked, not yet recorded by the pool for 1.5 s
+    start(self)
+    print("forked", flush=True)
+    time.sleep(1.5)
+
+
+def work(x):
+    time.sleep(0.05)
+    return x
+
+
+if __name__ == "__main__":
+    mpp.BaseProcess.start = slow_start
+    parallel_map(work, list(range(2000)), workers=2)
+"""
+
+
+@pytest.mark.parametrize(("sig", "target"), [(signal.SIGINT, "group"), (signal.SIGTERM, "parent")])
+def test_a_signal_while_the_workers_start_leaves_no_worker_behind(tmp_path, sig, target):
+    """A signal between a worker's fork and the pool recording it (a loaded machine's timing)
+    still ends everything: before the fix, that worker was left running and the exit hung."""
+    script = tmp_path / "slow_start.py"
+    script.write_text(SLOW_START)
+    proc = subprocess.Popen([sys.executable, str(script)], stdout=subprocess.PIPE,
+                            stderr=subprocess.STDOUT, start_new_session=True)  # fmt: skip
+    assert proc.stdout.readline().strip() == b"forked"  # the signal lands inside slow_start
+    (os.killpg if target == "group" else os.kill)(proc.pid, sig)
+    try:
+        proc.wait(timeout=10)
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)
+        pytest.fail("the process did not stop within 10 s")
+    assert proc.returncode != 0
+    time.sleep(0.5)
+    assert group_alive(proc.pid) == [], "processes survived"

@@ -4,7 +4,10 @@ that stops cleanly on Ctrl-C.
 Interrupts: pool workers ignore SIGINT (a terminal's Ctrl-C reaches the whole process group),
 so only the parent reacts. On SIGINT or SIGTERM the parent cancels the pending work, kills
 the workers and waits for them, then raises ``KeyboardInterrupt``; nothing is left running
-and no worker is orphaned. Results already written by a stage stay (atomic writes).
+and no worker is orphaned. A signal that arrives while the workers are being started is acted
+on once they all are (a worker forked but not yet recorded by the pool would otherwise be
+left running, and the interpreter's exit would wait for it). Results already written by a
+stage stay (atomic writes).
 """
 
 from __future__ import annotations
@@ -13,8 +16,9 @@ import os
 import signal
 import sys
 import threading
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import ProcessPoolExecutor
+from contextlib import contextmanager, nullcontext
 from typing import TypeVar
 
 from tqdm.auto import tqdm
@@ -40,8 +44,33 @@ def progress(iterable: Iterable[T], total: int, desc: str) -> Iterable[T]:
 
 
 def _ignore_sigint() -> None:
-    """Pool worker initializer: leave Ctrl-C to the parent."""
+    """Pool worker initializer: leave Ctrl-C to the parent; SIGTERM ends the worker (it was
+    forked while the parent deferred it, :func:`_deferred_signals`)."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+
+
+@contextmanager
+def _deferred_signals() -> Iterator[None]:
+    """SIGINT and SIGTERM received inside the block are acted on (by the handlers in place
+    before it) when it ends, the first one only. Main thread only."""
+    got: list[int] = []
+    old = {s: signal.signal(s, lambda signum, frame: got.append(signum))
+           for s in (signal.SIGINT, signal.SIGTERM)}  # fmt: skip
+    try:
+        yield
+    finally:
+        for s, handler in old.items():
+            signal.signal(s, signal.SIG_DFL if handler is None else handler)
+        if got:
+            signal.raise_signal(got[0])
+
+
+def _start_workers(pool: ProcessPoolExecutor, workers: int) -> None:
+    """Start every worker of ``pool`` now (a no-op task each: with 'fork' the first submit
+    starts them all, with 'spawn'/'forkserver' each submit starts one while none is idle)."""
+    for _ in range(workers):
+        pool.submit(int)
 
 
 def _terminate(pool: ProcessPoolExecutor) -> None:
@@ -84,6 +113,8 @@ def parallel_map(
     main = threading.current_thread() is threading.main_thread()
     previous = signal.signal(signal.SIGTERM, stop) if main else None
     try:
+        with _deferred_signals() if main else nullcontext():
+            _start_workers(pool, workers)
         results = list(progress(pool.map(fn, items, chunksize=chunksize), len(items), desc))
     except BaseException:
         _terminate(pool)
