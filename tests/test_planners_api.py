@@ -16,6 +16,7 @@ from vnrrt.planners import (
     astar_length,
     make_sampler,
     plan,
+    polyline_length,
     run,
     segment_free,
 )
@@ -398,3 +399,36 @@ def test_a_prebuilt_sampler_is_checked_against_the_config(grid, heat, built, con
     small = make_sampler("rrt_star", (100, 200))
     with pytest.raises(GridError, match="shape"):
         plan(grid, START, GOAL, sampler=small)
+
+
+def test_a_finished_tree_gives_its_branch_segment_lengths_and_trace():
+    """tree.finish on a hand-made tree: root (0, 0) -> (3, 4) -> goal (3, 10); the final cost
+    is appended to the trace only when it is not the last point traced."""
+    links = np.full((4, 4), -1, np.int64)
+    links[1, nodes.PARENT], links[2, nodes.PARENT] = 0, 1
+    pts = np.array([[0.0, 0.0], [3.0, 4.0], [3.0, 10.0], [9.0, 9.0]])
+    cost = np.array([0.0, 5.0, 11.0, 99.0])
+    iters, costs = np.array([7, 0, 0], np.int64), np.array([12.0, 0.0, 0.0])
+    path, segs, trace_it, trace_cost = nodes.finish(links, pts, cost, 2, iters, costs, 1, 30)
+    assert np.array_equal(path, pts[:3]) and path.dtype == np.float64
+    assert segs.tolist() == [5.0, 6.0] and float(np.add.reduce(segs)) == polyline_length(path)
+    assert trace_it.tolist() == [7, 30] and trace_cost.tolist() == [12.0, 11.0]
+    costs[0] = 11.0  # the final cost already traced: nothing appended
+    _, _, trace_it, trace_cost = nodes.finish(links, pts, cost, 2, iters, costs, 1, 30)
+    assert trace_it.tolist() == [7] and trace_cost.tolist() == [11.0]
+    path, segs, trace_it, trace_cost = nodes.finish(links, pts, cost, -1, iters, costs, 0, 30)
+    assert path.shape == (0, 2) and segs.size == 0 and trace_it.size == trace_cost.size == 0
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_a_result_costs_exactly_its_paths_polyline_length(grid, seed):
+    """The cost returned is the polyline length of the path returned, to the last bit, solved
+    or not; an unsolved run returns an empty path of infinite cost."""
+    r = plan(
+        grid, START, GOAL, stop="optimal", seed=seed, config=PlannerConfig(max_iterations=3000)
+    )
+    assert r.path.dtype == np.float64 and r.cost == polyline_length(r.path)
+    assert r.trace_iterations.dtype == np.int64 and r.trace_iterations[-1] <= r.iterations
+    short = plan(grid, START, GOAL, seed=seed, config=PlannerConfig(max_iterations=1))
+    assert not short.success and short.path.shape == (0, 2) and short.cost == math.inf
+    assert short.first_cost == math.inf and short.trace_costs.size == 0

@@ -22,7 +22,6 @@ import numpy as np
 
 from vnrrt.planners import clock, core, loop
 from vnrrt.planners import tree as nodes
-from vnrrt.planners.collision import polyline_length
 from vnrrt.planners.loop import FIRST_CHUNK, MAX_CHUNK
 from vnrrt.planners.result import Milestone, PlanResult
 
@@ -241,8 +240,18 @@ def search(
     job = Job(draws, params, first, rng, stops, query.target, work.budget, t0)
     reason, times, iters = drive(run, occ, job)
     elapsed = time.perf_counter() - t0
-    reached = {b: (float(t), int(i)) for b, t, i in zip(stops, times, iters, strict=True)}
+    reached = dict(zip(stops.tolist(), zip(_floats(times), _ints(iters)), strict=True))
     return result(run, planner, query, reason=reason, reached=reached, elapsed=elapsed)
+
+
+def _floats(values) -> list[float]:
+    """``values`` (an array or a list) as a list of Python floats."""
+    return values.tolist() if isinstance(values, np.ndarray) else [float(v) for v in values]
+
+
+def _ints(values) -> list[int]:
+    """``values`` (an array or a list) as a list of Python ints."""
+    return values.tolist() if isinstance(values, np.ndarray) else [int(v) for v in values]
 
 
 REASONS = {loop.SOLVED: "solved", loop.MAX_ITERATIONS: "max_iterations",
@@ -336,21 +345,18 @@ def result(
     elapsed: float,
 ) -> PlanResult:
     """The :class:`PlanResult` of a finished run; ``reached[bound] = (seconds, iteration)``."""
-    c, tree = run.counters, run.tree
+    c, tree, trace = run.counters, run.tree, run.trace
     n, g, k = int(c.nodes[0]), int(c.goal[0]), int(c.trace_len[0])
-    path = nodes.branch(tree.links, tree.pts, g) if g >= 0 else np.zeros((0, 2))
-    last = k and run.trace.costs[k - 1] != tree.cost[g]  # the final value, when not traced
-    trace_it, trace_cost = np.empty(k + last, np.int64), np.empty(k + last)
-    trace_it[:k], trace_cost[:k] = run.trace.iters[:k], run.trace.costs[:k]
-    if last:
-        trace_it[k], trace_cost[k] = c.iters[0], tree.cost[g]
+    path, segs, trace_it, trace_cost = nodes.finish(
+        tree.links, tree.pts, tree.cost, g, trace.iters, trace.costs, k, int(c.iters[0])
+    )
     first_time, first_iter = reached[math.inf]
     return PlanResult.of({
         "planner": planner,
         "success": reason == "solved",
         "stop_reason": reason,
         "path": path,
-        "cost": polyline_length(path) if g >= 0 else math.inf,
+        "cost": float(np.add.reduce(segs)) if g >= 0 else math.inf,  # = polyline_length(path)
         "iterations": int(c.iters[0]),
         "tree_size": n,
         "collision_checks": int(c.checks[0]),

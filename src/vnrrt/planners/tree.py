@@ -10,6 +10,7 @@ solution cost.
 
 from __future__ import annotations
 
+import math
 from typing import NamedTuple
 
 import numpy as np
@@ -195,3 +196,22 @@ def branch(links: np.ndarray, pts: np.ndarray, node: int) -> np.ndarray:
         out[i, 0], out[i, 1] = pts[v, 0], pts[v, 1]
         v = links[v, PARENT]
     return out
+
+
+@njit(cache=True)
+def finish(links, pts, cost, goal, trace_iters, trace_costs, k, iters_now):
+    """What a finished run returns, in one compiled call: the path ``(K, 2)`` from the root to
+    ``goal`` (``(0, 2)`` when ``goal`` is -1), its ``K - 1`` segment lengths (``hypot`` of the
+    coordinate differences, the values :func:`vnrrt.planners.collision.polyline_length` sums),
+    and the best-cost trace (iterations int64, costs float64): its ``k`` points, then the
+    goal's cost at iteration ``iters_now`` when that is not the last point traced."""
+    path = branch(links, pts, goal) if goal >= 0 else np.zeros((0, 2))
+    segs = np.empty(max(path.shape[0] - 1, 0))
+    for i in range(segs.shape[0]):
+        segs[i] = math.hypot(path[i + 1, 0] - path[i, 0], path[i + 1, 1] - path[i, 1])
+    last = 1 if k > 0 and goal >= 0 and trace_costs[k - 1] != cost[goal] else 0
+    out_iters, out_costs = np.empty(k + last, np.int64), np.empty(k + last)
+    out_iters[:k], out_costs[:k] = trace_iters[:k], trace_costs[:k]
+    if last:
+        out_iters[k], out_costs[k] = iters_now, cost[goal]
+    return path, segs, out_iters, out_costs
