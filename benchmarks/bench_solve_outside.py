@@ -15,27 +15,15 @@ from __future__ import annotations
 
 import argparse
 import functools
-import gc
 import sys
-import time
 
 import numpy as np
 
+from bench_planner_overhead import timed
 from planner_maps import dev_instances
 from vnrrt.planners import FASTEST, Planner, any_angle_path, plan, warmup
 
 MAPS = ("open", "random1", "random11")
-
-
-def timed(fn):
-    """``fn()`` and the seconds it took, the garbage collector off meanwhile."""
-    gc.disable()
-    try:
-        t0 = time.perf_counter()
-        out = fn()
-        return out, time.perf_counter() - t0
-    finally:
-        gc.enable()
 
 
 def main(argv: list[str] | None = None) -> int:

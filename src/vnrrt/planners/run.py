@@ -240,18 +240,8 @@ def search(
     job = Job(draws, params, first, rng, stops, query.target, work.budget, t0)
     reason, times, iters = drive(run, occ, job)
     elapsed = time.perf_counter() - t0
-    reached = dict(zip(stops.tolist(), zip(_floats(times), _ints(iters)), strict=True))
+    reached = dict(zip(stops.tolist(), zip(times.tolist(), iters.tolist()), strict=True))
     return result(run, planner, query, reason=reason, reached=reached, elapsed=elapsed)
-
-
-def _floats(values) -> list[float]:
-    """``values`` (an array or a list) as a list of Python floats."""
-    return values.tolist() if isinstance(values, np.ndarray) else [float(v) for v in values]
-
-
-def _ints(values) -> list[int]:
-    """``values`` (an array or a list) as a list of Python ints."""
-    return values.tolist() if isinstance(values, np.ndarray) else [int(v) for v in values]
 
 
 REASONS = {loop.SOLVED: "solved", loop.MAX_ITERATIONS: "max_iterations",
@@ -297,19 +287,19 @@ def make_room(run: Tree, budget: Budget) -> None:
     run.enlarge(min(2 * run.capacity, budget.max_iterations + 2))
 
 
-def drive_python(run: Tree, occ: np.ndarray, job: Job) -> tuple[str, list[float], list[int]]:
+def drive_python(run: Tree, occ: np.ndarray, job: Job) -> tuple[str, np.ndarray, np.ndarray]:
     """Plant the tree and grow it in compiled chunks until the stop rule or a budget is met,
     timing it in Python (where :data:`vnrrt.planners.clock.IN_KERNEL` is False).
 
     Returns ``(stop_reason, times, iterations)``: per entry of ``stops`` (decreasing cost
     bounds), the time (s since ``t0``, ``time.perf_counter``) and iteration at which it was
-    first reached (NaN / -1: never).
+    first reached (NaN / -1: never), float64 and int64 as :func:`drive_compiled` returns them.
     """
     tree, _, c, trace = run.flat
     stops, budget = job.stops, job.budget
     core.plant_flat(occ, tree, c, run.scratch.stack, trace, job.first, stops)
     c = run.counters
-    times, iters = [math.nan] * len(stops), [-1] * len(stops)
+    times, iters = np.full(len(stops), np.nan), np.full(len(stops), -1, np.int64)
     chunk, passed, status = FIRST_CHUNK, 0, core.RUNNING
     draws, params_t = job.draws, tuple(job.params)
     draws_t = tuple(draws)
