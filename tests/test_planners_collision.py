@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from vnrrt.planners import path_free, point_free, segment_free
+from vnrrt.planners import core, path_free, point_free, segment_free
 
 
 def touches_box(p0, p1, lo, hi) -> bool:
@@ -101,3 +101,29 @@ def test_path_free_checks_every_segment():
     ok = np.array([[0.5, 0.5], [5.5, 0.5], [5.5, 5.5]])
     bad = np.array([[0.5, 0.5], [0.5, 5.5], [5.5, 0.5]])  # last leg crosses (3, 3)'s corner
     assert path_free(g, ok) and not path_free(g, bad)
+
+
+@pytest.mark.parametrize("lattice", [False, True])
+def test_a_querys_compiled_checks_match_the_brute_force_reference(grid, lattice):
+    """core.query_test: BAD_ENDPOINT when either endpoint touches an obstacle or the border,
+    else the start-goal distance when the segment is free and -1 when it is blocked (or, with
+    ``straight`` False, -1 without testing it); checked against :func:`reference_free`."""
+    rng = np.random.default_rng(29 + lattice)
+    h, w = grid.shape
+    seen = set()
+    for _ in range(1500):
+        p = rng.uniform(0.2, [w - 0.2, h - 0.2, w - 0.2, h - 0.2])
+        if lattice:  # endpoints on cell edges and corners
+            p = np.clip(np.round(p * 2) / 2, 0.5, [w - 0.5, h - 0.5, w - 0.5, h - 0.5])
+        a, b = p[:2], p[2:]
+        if not (reference_free(grid, a, a) and reference_free(grid, b, b)):
+            want = core.BAD_ENDPOINT
+        elif reference_free(grid, a, b):
+            want = float(np.hypot(*(b - a)))
+        else:
+            want = -1.0
+        assert core.query_test(grid, *p, True) == pytest.approx(want, abs=1e-12), p
+        plain = core.query_test(grid, *p, False)
+        assert plain == (core.BAD_ENDPOINT if want == core.BAD_ENDPOINT else -1.0), p
+        seen.add("bad" if want == core.BAD_ENDPOINT else "blocked" if want < 0 else "free")
+    assert seen == {"bad", "blocked", "free"}

@@ -85,7 +85,10 @@ def as_point(grid: np.ndarray, point, name: str) -> tuple[float, float]:
 
     The point must be finite, inside ``[0, W) x [0, H)`` and in a free cell.
     """
-    arr = np.asarray(point, dtype=np.float64)
+    try:
+        arr = np.asarray(point, dtype=np.float64)
+    except (TypeError, ValueError):  # not numbers: e.g. strings, ragged sequences
+        arr = np.full(0, np.nan)
     if arr.shape != (2,) or not np.all(np.isfinite(arr)):
         raise GridError(f"{name} must be a finite point (x, y), got {point!r}")
     x, y = float(arr[0]), float(arr[1])

@@ -26,7 +26,7 @@ import numpy as np
 
 from vnrrt.grid import GridError, as_occupancy, as_point
 from vnrrt.planners import core, run
-from vnrrt.planners.collision import points_free, segment_free
+from vnrrt.planners.collision import segment_free
 from vnrrt.planners.config import PLANNERS, PlannerConfig
 from vnrrt.planners.reference import reference_length as compute_reference
 from vnrrt.planners.result import PlanResult
@@ -117,16 +117,22 @@ def _endpoint(occ: np.ndarray, point, name: str) -> tuple[float, float]:
     raise GridError(f"{name} {(x, y)} touches an obstacle cell or the map border")
 
 
-def _endpoints(occ: np.ndarray, start, goal) -> tuple[tuple[float, float], tuple[float, float]]:
-    """:func:`_endpoint` of both points; valid ones checked in one compiled call."""
+def _endpoints(occ: np.ndarray, start, goal, straight: bool):
+    """:func:`_endpoint` of both points, and :func:`run.straight_test`'s answer (the
+    straight segment tested when ``straight``): valid points are checked in that one
+    compiled call. Returns ``(start, goal, tested)``."""
     try:
         (sx, sy), (gx, gy) = start, goal
         sx, sy, gx, gy = float(sx), float(sy), float(gx), float(gy)
+        finite = math.isfinite(sx + sy + gx + gy)
     except (TypeError, ValueError):
-        sx = math.nan
-    if math.isfinite(sx + sy + gx + gy) and points_free(occ, sx, sy, gx, gy):
-        return (sx, sy), (gx, gy)
-    return _endpoint(occ, start, "start"), _endpoint(occ, goal, "goal")  # one of them raises
+        finite = False
+    if finite:
+        tested = run.straight_test(occ, sx, sy, gx, gy, straight)
+        if tested[0] != core.BAD_ENDPOINT:
+            return (sx, sy), (gx, gy), tested
+    start, goal = _endpoint(occ, start, "start"), _endpoint(occ, goal, "goal")  # one raises
+    return start, goal, run.straight_test(occ, *start, *goal, straight)
 
 
 def _seed(seed) -> None:
@@ -146,10 +152,12 @@ def _logged(result: PlanResult) -> PlanResult:
 
 def _query(occ: np.ndarray, cfg: PlannerConfig, start, goal, stop: str, reference_length,
            seed, milestones, keep_tree: bool, setup_time: float = 0.0,
-           fallback: bool = False) -> run.Query:  # fmt: skip
+           fallback: bool = False) -> tuple[run.Query, tuple[float, float]]:  # fmt: skip
     """The validated query of a solve (arguments and errors: :meth:`Planner.solve`), the
-    compiled kernels loaded (:func:`warmup`)."""
-    start, goal = _endpoints(occ, start, goal)
+    compiled kernels loaded (:func:`warmup`), and the straight segment's test when
+    ``cfg.straight_first`` (:func:`run.straight_test`; made with the endpoints' checks)."""
+    warmup()  # before the straight segment's timed test: its kernel loaded
+    start, goal, tested = _endpoints(occ, start, goal, cfg.straight_first)
     if stop not in ("initial", "optimal"):
         raise ValueError(f"unknown stop rule {stop!r}; use 'initial' or 'optimal'")
     _seed(seed)
@@ -161,9 +169,9 @@ def _query(occ: np.ndarray, cfg: PlannerConfig, start, goal, stop: str, referenc
         raise ValueError(f"reference_length must be finite and >= 0, got {reference_length}")
     target = None if stop == "initial" else (1.0 + cfg.eps) * reference_length
     bounds = tuple(float(m) for m in milestones) if milestones else ()
-    warmup()
-    return run.Query(start, goal, target, bounds, keep_tree, reference_length, setup_time,
-                     fallback)  # fmt: skip
+    query = run.Query(start, goal, target, bounds, keep_tree, reference_length, setup_time,
+                      fallback)  # fmt: skip
+    return query, tested
 
 
 class Planner:
@@ -271,16 +279,13 @@ class Planner:
             ValueError: unknown stop rule, bad reference length or seed.
         """
         ask = (stop, reference_length, seed, milestones, keep_tree)
-        query = _query(self.occ, self.config, start, goal, *ask, self.setup_time,
-                       self.sampler.fallback_uniform)  # fmt: skip
-        return self._run(query, seed)
+        query, tested = _query(self.occ, self.config, start, goal, *ask, self.setup_time,
+                               self.sampler.fallback_uniform)  # fmt: skip
+        return self._run(query, seed, tested)
 
-    def _run(self, query: run.Query, seed, tested: tuple[float, float] | None = None) -> PlanResult:
-        """The timed run of a validated query (:mod:`.run`); ``tested``: the straight
-        segment's test already made (:func:`run.straight_test`), when it was."""
-        if tested is None:
-            tested = run.straight_test(self.occ, query) if self.config.straight_first else (
-                -1.0, 0.0)  # fmt: skip
+    def _run(self, query: run.Query, seed, tested: tuple[float, float]) -> PlanResult:
+        """The timed run of a validated query (:mod:`.run`); ``tested``: its straight
+        segment's test (:func:`run.straight_test`, made by :func:`_query`)."""
         result = run.straight_answer(self.planner, query, tested)
         if result is None:
             d, spent = tested
@@ -338,14 +343,13 @@ def plan(
     and :meth:`Planner.solve`. Returns a :class:`PlanResult`. RRT* with ``straight_first``
     answers a free straight segment that meets the stop rule without building the
     :class:`Planner` (the same result, without its setup's microseconds)."""
-    ask = (stop, reference_length, seed, milestones, keep_tree)
-    query = tested = None
+    query = None
     if planner == "rrt_star" and heatmap is None and sampler is None:
         config = _config(config)  # uniform sampling: the free segment needs no Planner
         if config.straight_first:
             grid = _occupancy(grid)
-            query = _query(grid, config, start, goal, *ask)
-            tested = run.straight_test(grid, query)
+            query, tested = _query(grid, config, start, goal, stop, reference_length, seed,
+                                   milestones, keep_tree)  # fmt: skip
             answer = run.straight_answer(planner, query, tested)
             if answer is not None:
                 return _logged(answer)
@@ -373,8 +377,7 @@ def warmup() -> None:
             cfg = PlannerConfig(max_iterations=200, informed=informed)
             p = Planner(occ, planner, heatmap=hm, config=cfg)
             query = run.Query((1.5, 3.5), (6.5, 3.5), 0.0, (), False, None, 0.0, False)
-            p._run(query, 0)
-    core.straight_cost(occ, 0.5, 0.5, 1.5, 1.5)
-    points_free(occ, 0.5, 0.5, 1.5, 1.5)
-    Planner(occ, config=PlannerConfig(max_iterations=200, gap_share=0.5))._run(query, 0)
+            p._run(query, 0, run.straight_test(occ, 1.5, 3.5, 6.5, 3.5, True))
+    tested = run.straight_test(occ, 1.5, 3.5, 6.5, 3.5, False)
+    Planner(occ, config=PlannerConfig(max_iterations=200, gap_share=0.5))._run(query, 0, tested)
     log.debug("planner kernels compiled")

@@ -39,7 +39,7 @@ import numpy as np
 from numba import njit
 
 from vnrrt.planners import spatial
-from vnrrt.planners.collision import segment_free
+from vnrrt.planners.collision import points_free, segment_free
 from vnrrt.planners.gaps import gap_cells
 from vnrrt.planners.refine import AT_REST, IMPROVED, refine_step
 from vnrrt.planners.samplers import NO_CELLS, any_point, next_double
@@ -208,6 +208,21 @@ def straight_cost(occ, sx, sy, gx, gy):
     if not segment_free(occ, sx, sy, gx, gy):
         return -1.0
     return 0.0 + math.hypot(gx - sx, gy - sy)
+
+
+BAD_ENDPOINT = -2.0  # :func:`query_test`: start or goal touches an obstacle or the border
+
+
+@njit(cache=True)
+def query_test(occ, sx, sy, gx, gy, straight):
+    """A query's checks in one compiled call: :data:`BAD_ENDPOINT` when start or goal
+    touches an obstacle cell or the map border (:func:`~.collision.points_free`); else,
+    with ``straight``, :func:`straight_cost` (the distance, -1 when blocked); else -1."""
+    if not points_free(occ, sx, sy, gx, gy):
+        return BAD_ENDPOINT
+    if not straight:
+        return -1.0
+    return straight_cost(occ, sx, sy, gx, gy)
 
 
 @njit(cache=True)

@@ -79,15 +79,17 @@ class PlanResult:
     @classmethod
     def of(cls, values: dict) -> PlanResult:
         """The result holding ``values``, a value for every field (a ``TypeError`` names a
-        missing or unknown one). What the planners build their results with: the same
-        object as ``PlanResult(**values)`` without the generated ``__init__``, which sets
-        each of the 21 fields of a frozen dataclass through ``object.__setattr__``
-        (microseconds, most of a solve that one segment test answers)."""
+        missing or unknown one); the result takes ``values`` as its ``__dict__`` (pass a
+        dict made for it, not one you keep). What the planners build their results with:
+        the same object as ``PlanResult(**values)`` without the generated ``__init__``,
+        which sets each of the 21 fields of a frozen dataclass through
+        ``object.__setattr__``, and without copying them into a new dict (together
+        microseconds, most of a solve that one segment test answers)."""
         if values.keys() != FIELDS:
             wrong = sorted(FIELDS ^ values.keys())
             raise TypeError(f"PlanResult.of needs every field; missing or unknown: {wrong}")
         result = object.__new__(cls)
-        result.__dict__.update(values)
+        object.__setattr__(result, "__dict__", values)
         return result
 
     def summary(self) -> str:

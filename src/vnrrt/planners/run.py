@@ -163,13 +163,16 @@ def stop_bounds(query: Query) -> np.ndarray:
     return np.array(sorted(wanted, reverse=True))
 
 
-def straight_test(occ: np.ndarray, query: Query) -> tuple[float, float]:
-    """The start-goal distance when the segment between them is free (-1 when blocked), and
-    the seconds the test took (the first part of a run's time)."""
-    (sx, sy), (gx, gy) = query.start, query.goal
+def straight_test(occ: np.ndarray, sx: float, sy: float, gx: float, gy: float,
+                  straight: bool) -> tuple[float, float]:  # fmt: skip
+    """A query's compiled checks (:func:`vnrrt.planners.core.query_test`): the start-goal
+    distance when ``straight`` and the segment between them is free, -1 when it is blocked
+    or not tested, :data:`~vnrrt.planners.core.BAD_ENDPOINT` when start or goal touches an
+    obstacle or the border; and, with ``straight``, the seconds the call took (the first
+    part of a run's time; the endpoints' two point tests are in it), else 0."""
     t0 = time.perf_counter()
-    d = core.straight_cost(occ, sx, sy, gx, gy)
-    return d, time.perf_counter() - t0
+    d = core.query_test(occ, sx, sy, gx, gy, straight)
+    return d, (time.perf_counter() - t0 if straight else 0.0)
 
 
 def straight_answer(planner: str, query: Query, tested: tuple[float, float]) -> PlanResult | None:
