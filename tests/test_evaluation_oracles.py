@@ -18,6 +18,7 @@ from vnrrt.evaluation.oracles import OracleSource, blend, dilute, oracle_heatmap
 from vnrrt.evaluation.sampling_ideas.design import (
     evaluation_keys,
     family_members,
+    protocol_settings,
     regime_cells,
     selection_keys,
     split_instances,
@@ -34,6 +35,9 @@ from vnrrt.maps.config import DataConfig
 from vnrrt.maps.generate import generate_map, map_rng
 from vnrrt.planners import PlannerConfig, plan
 from vnrrt.search import any_angle_path, astar, path_vertices
+
+# a protocol with a Steer step of 7 px: no grid cell below repeats it
+ELSEWHERE = protocol_settings(PlannerConfig(eta=7.0))
 
 
 def make_instance(map_id: int, k: int = 0) -> EvalInstance:
@@ -206,7 +210,7 @@ def test_the_evaluation_runs_the_envelopes_and_every_blend_weight():
                       goal_radii=[None], configurations=["rrt_star", "vnrrt_star"])  # fmt: skip
     env = {"optimal": {"path": "nrrt_star~0.5[oracle_path@s2]",
                        "blend": "vnrrt_star~0.5[oracle_blend@w0.5@s4]"}}  # fmt: skip
-    cells = evaluation_keys(env, oc, rc, ev)
+    cells = evaluation_keys(env, oc, rc, ev, ELSEWHERE)
     assert set(cells) == {"protocol", "eta=10 radius=shrinking goal=eta"}
     grid = {k.text for k in cells["eta=10 radius=shrinking goal=eta"]}
     assert {"rrt_star", "vnrrt_star", *env["optimal"].values()} <= grid
@@ -224,7 +228,7 @@ def test_a_sweep_cell_changes_the_setting_it_names(turning):
     modes = ["shrinking", "fixed2"]
     rc = RegimeConfig(etas=[5.0, 20.0], radius_modes=modes, gamma_factors=[1.0],
                       goal_radii=[None, 2.0])  # fmt: skip
-    cells = regime_cells(rc)
+    cells = regime_cells(rc, protocol_settings(PlannerConfig()))
     assert len(cells) == 8 and cells["eta=5 radius=fixed2 goal=2"]["fixed_radius"] == 10.0
     base, longest = PlannerConfig(), {}
     for label, over in cells.items():
@@ -256,7 +260,7 @@ def test_an_unlimited_step_and_a_small_gamma_change_the_tree(turning):
     unlimited fixed radius is left out of the grid."""
     rc = RegimeConfig(etas=[10.0, math.inf], radius_modes=["shrinking", "fixed1"],
                       gamma_factors=[1.0, 0.01], goal_radii=[None])  # fmt: skip
-    cells = regime_cells(rc)
+    cells = regime_cells(rc, ELSEWHERE)
     assert "eta=inf radius=fixed1 goal=eta" not in cells and len(cells) == 5
     base = PlannerConfig(max_iterations=3000)
     trees = {}
@@ -290,3 +294,26 @@ def test_taut_oracles_are_measured_against_the_exact_path(turning):
     assert mass_near(heat, target_mask(turning, "taut_vertices"), 3.0) > 0.9
     heat = instance_heatmap("oracle_taut_path@s1", turning, None, 0.0, every)
     assert mass_near(heat, target_mask(turning, "taut_path"), 3.0) > 0.9
+
+
+def test_the_cell_with_the_protocols_own_settings_is_left_out(turning):
+    """A grid cell whose overrides all equal the protocol's settings would repeat the
+    protocol cell's runs exactly (the same planner settings and seeds: the same result, checked
+    through plan()); it is left out of the grid and of the evaluation, and only it."""
+    rc = RegimeConfig(etas=[10.0, 20.0], radius_modes=["shrinking", "fixed1"],
+                      gamma_factors=[1.0, 0.5], goal_radii=[None, math.inf])  # fmt: skip
+    base = PlannerConfig(max_iterations=2000)
+    every, cells = regime_cells(rc, ELSEWHERE), regime_cells(rc, protocol_settings(base))
+    twin = "eta=10 radius=shrinking goal=eta"
+    assert set(every) - set(cells) == {twin} and len(cells) == len(every) - 1 == 11
+    assert base.replace(**every[twin]) == base
+    runs = [plan(turning.grid, turning.start, turning.goal, config=c, seed=3, stop="optimal",
+                 reference_length=1e-9) for c in (base, base.replace(**every[twin]))]  # fmt: skip
+    assert runs[0].iterations == runs[1].iterations and runs[0].cost == runs[1].cost
+    ev = Configurations(sources={"vnrrt_star": "vertexnet"}, informed=False)
+    env = {"optimal": {"path": "nrrt_star~0.5[oracle_path@s2]"}}
+    oc = OracleConfig(blend_weights=[0.0], qualities=[1.0])
+    keys = evaluation_keys(env, oc, rc, ev, protocol_settings(base))
+    assert twin not in keys and set(keys) == {"protocol", *cells}
+    fixed = regime_cells(rc, protocol_settings(base.replace(radius_mode="fixed")))
+    assert "eta=10 radius=fixed1 goal=eta" not in fixed and twin in fixed  # fixed_radius 10

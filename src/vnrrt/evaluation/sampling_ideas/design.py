@@ -12,9 +12,10 @@
   family's best member per stop rule (the most RRT* iterations saved,
   :func:`vnrrt.evaluation.sampling_ideas.selection.select`) is its **envelope**.
 * **Evaluation** (stage ``regime@<k>``): on the evaluation instances, in the protocol's cell
-  and in every cell of ``regime.etas x`` radius rules ``x regime.goal_radii``
-  (:func:`regime_cells`): RRT*, ``regime.configurations`` (the trained networks), every
-  envelope and the blend at every weight (at the blend envelope's blur and mix); the
+  and in every other cell of ``regime.etas x`` radius rules ``x regime.goal_radii``
+  (:func:`regime_cells`; one with the protocol's own settings is the protocol's): RRT*,
+  ``regime.configurations`` (the trained networks), every envelope and the blend at every
+  weight (at the blend envelope's blur and mix); the
   protocol's cell also runs the quality curve (each path and vertex envelope diluted to signal
   fraction ``oracle.qualities``, :func:`vnrrt.evaluation.oracles.dilute`) and every
   configuration under the other obstacle rule (``+free``).
@@ -107,10 +108,11 @@ def diluted(key: ConfigKey, q: float) -> ConfigKey:
 
 
 def evaluation_keys(
-    envelopes: dict, oc: OracleConfig, rc: RegimeConfig, ev: Configurations
+    envelopes: dict, oc: OracleConfig, rc: RegimeConfig, ev: Configurations, protocol: dict
 ) -> dict[str, list[ConfigKey]]:
     """``{cell: keys}`` of the evaluation (module doc); ``envelopes``: ``{stop: {idea: key
-    text}}`` (:func:`vnrrt.evaluation.sampling_ideas.selection.select`)."""
+    text}}`` (:func:`vnrrt.evaluation.sampling_ideas.selection.select`); ``protocol``: the
+    protocol cell's settings (:func:`protocol_settings`)."""
     chosen = list(
         dict.fromkeys(ConfigKey.parse(t) for per in envelopes.values() for t in per.values())
     )
@@ -127,7 +129,7 @@ def evaluation_keys(
     ]
     flipped = [k.with_free(not ev.zero_obstacles) for k in [*base, *chosen]]
     cells = {PROTOCOL: list(dict.fromkeys([*every, *quality, *flipped]))}
-    cells |= {label: every for label in regime_cells(rc)}
+    cells |= {label: every for label in regime_cells(rc, protocol)}
     return cells
 
 
@@ -161,11 +163,24 @@ def radius_rules(rc: RegimeConfig) -> list[tuple[str, dict]]:
     return out
 
 
-def regime_cells(rc: RegimeConfig) -> dict[str, dict]:
+CELL_SETTINGS = ("eta", "radius_mode", "gamma_factor", "fixed_radius", "goal_radius")
+"""The planner settings a regime cell overrides (``planner.<name>``)."""
+
+
+def protocol_settings(planner) -> dict:
+    """``{name: value}`` of :data:`CELL_SETTINGS` in ``planner`` (a
+    :class:`~vnrrt.planners.config.PlannerConfig` or the config's ``planner`` section): the
+    protocol's cell."""
+    return {k: getattr(planner, k) for k in CELL_SETTINGS}
+
+
+def regime_cells(rc: RegimeConfig, protocol: dict) -> dict[str, dict]:
     """``{label: planner overrides}`` of every cell besides the protocol's, e.g.
     ``eta=5 radius=shrinking*0.1 goal=inf``: ``{"eta": 5.0, "radius_mode": "shrinking",
-    "gamma_factor": 0.1, "goal_radius": inf}``. An unlimited step with a fixed radius (every
-    node near) is left out."""
+    "gamma_factor": 0.1, "goal_radius": inf}``. Left out: an unlimited step with a fixed
+    radius (every node near), and the cell whose overrides all equal ``protocol``'s settings
+    (:func:`protocol_settings`): it would repeat the protocol cell's runs exactly (the same
+    seeds; the study's counts would count that setting twice)."""
     cells = {}
     for eta in rc.etas:
         for name, rule in radius_rules(rc):
@@ -177,9 +192,7 @@ def regime_cells(rc: RegimeConfig) -> dict[str, dict]:
             for goal in rc.goal_radii:
                 goal_label = "eta" if goal is None else f"{goal:g}"
                 g = None if goal is None else float(goal)
-                cells[f"eta={eta:g} radius={name} goal={goal_label}"] = {
-                    "eta": float(eta),
-                    "goal_radius": g,
-                    **over,
-                }
+                cell = {"eta": float(eta), "goal_radius": g, **over}
+                if any(protocol[k] != v for k, v in cell.items()):
+                    cells[f"eta={eta:g} radius={name} goal={goal_label}"] = cell
     return cells

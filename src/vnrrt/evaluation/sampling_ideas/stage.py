@@ -27,13 +27,15 @@ log = logging.getLogger(__name__)
 
 @dataclass(frozen=True)
 class Study:
-    """The typed sections the study's stages read (``regime`` is None in the selection)."""
+    """The typed sections the study's stages read (``regime`` is None in the selection);
+    ``protocol``: the protocol cell's planner settings (:func:`.design.protocol_settings`)."""
 
     paths: Paths
     ev: Configurations
     oracle: OracleConfig
     regime: RegimeConfig | None
     seed: int
+    protocol: dict
 
     def instances(self) -> tuple[list[str], list[int], list[int]]:
         """``(kinds, selection, evaluation)``: the instance kinds and the split (design)."""
@@ -74,7 +76,8 @@ class Study:
 
         kinds, _, ev = self.instances()
         chosen, jobs = ev[: self.regime.random_maps], []
-        for cell, keys in d.evaluation_keys(envelopes, self.oracle, self.regime, self.ev).items():
+        every = d.evaluation_keys(envelopes, self.oracle, self.regime, self.ev, self.protocol)
+        for cell, keys in every.items():
             counts = d.evaluation_counts(self.regime, cell)
             seq = sum(j.count for j in jobs)
             jobs += trial_jobs(kinds, keys, counts, regimes=(cell,), instances=chosen, seq=seq)
@@ -85,10 +88,12 @@ def part_settings(cfg: DictConfig, which: str) -> dict:
     """What stage ``oracle@<k>`` (``which='oracle'``) or ``regime@<k>`` reads, typed (keyed
     by config section); the evaluation also reads the trained networks' heatmaps
     (``predict.parts``)."""
+    from vnrrt.evaluation.sampling_ideas.design import protocol_settings
     from vnrrt.planners.config import PlannerConfig
 
     typed = sections(cfg, paths=Paths, eval=Configurations, oracle=OracleConfig)
     typed |= sections(cfg, planner=PlannerConfig)
+    typed["protocol"] = protocol_settings(typed["planner"])
     typed["regime"] = section(cfg, "regime", RegimeConfig) if which == "regime" else None
     if which == "regime":
         typed["predict"] = {"parts": check_parts(cfg.predict.parts, "predict.parts")}
@@ -96,19 +101,22 @@ def part_settings(cfg: DictConfig, which: str) -> dict:
 
 
 def ideas_settings(cfg: DictConfig) -> dict:
-    """What stage ``ideas`` reads, typed (keyed by config section)."""
-    from vnrrt.evaluation.config import Rules, StatsConfig
+    """What stage ``ideas`` reads, typed (keyed by config section; ``protocol``: the
+    protocol cell's planner settings, :func:`.design.protocol_settings`)."""
+    from vnrrt.evaluation.config import StatsConfig, StudyRules
+    from vnrrt.evaluation.sampling_ideas.design import protocol_settings
     from vnrrt.tracking import LoggerConfig
 
     typed = sections(cfg, paths=Paths, eval=Configurations, oracle=OracleConfig)
-    typed |= sections(cfg, regime=RegimeConfig, planner=Rules, stats=StatsConfig)
+    typed |= sections(cfg, regime=RegimeConfig, planner=StudyRules, stats=StatsConfig)
     typed |= sections(cfg, logger=LoggerConfig)
+    typed["protocol"] = protocol_settings(typed["planner"])
     return typed | {"scale": {"name": str(cfg.scale.name)}, "seed": int(cfg.seed)}
 
 
 def _study(s: dict) -> Study:
     """The :class:`Study` of a stage's settings (:func:`part_settings`, :func:`ideas_settings`)."""
-    return Study(s["paths"], s["eval"], s["oracle"], s["regime"], s["seed"])
+    return Study(s["paths"], s["eval"], s["oracle"], s["regime"], s["seed"], s["protocol"])
 
 
 def _run(s: dict, jobs: list, configs: dict, out: Path, networks: list[str]) -> int:
@@ -154,7 +162,8 @@ def run_regime_part(cfg: DictConfig, part: int) -> int:
     st, planner = _study(s), s["planner"]
     _, envelopes = st.envelopes()
     jobs = _part(st.evaluation_jobs(envelopes), part, st.regime.parts, "regime")
-    cells = {label: planner.replace(**o) for label, o in regime_cells(st.regime).items()}
+    overrides = regime_cells(st.regime, st.protocol)
+    cells = {label: planner.replace(**o) for label, o in overrides.items()}
     networks = sorted({j.key.source for j in jobs if j.key.source and not is_oracle(j.key.source)})
     log.info("evaluation part %d/%d: %d jobs", part, len(st.regime.parts), len(jobs))
     return _run(s, jobs, {PROTOCOL: planner, **cells}, st.paths.regime_part(part), networks)
@@ -186,7 +195,7 @@ def ideas_summary(tables: dict, settings: dict) -> dict:
     shown |= {"radius": st.oracle.radius, "floor": st.oracle.floor}
     shown |= {"zero_obstacles": st.ev.zero_obstacles, "selection_share": st.oracle.selection_share}
     predict = read_json(st.paths.predict_metrics)["networks"]
-    study = {"oracle": st.oracle, "regime": st.regime, "ev": st.ev,
+    study = {"oracle": st.oracle, "regime": st.regime, "ev": st.ev, "protocol": st.protocol,
              "targets": {n: m["target"] for n, m in predict.items()}}  # fmt: skip
     return as_json(analyze_study(tables, study, pairs, shown))
 

@@ -250,9 +250,9 @@ def regime_claims(rows: list[dict], pairs: list[tuple[str, str]], table, boot) -
 
 def analyze_study(tables: dict, study: dict, pairs: list[tuple[str, str]], settings: dict) -> dict:
     """The whole summary: ``tables`` the merged selection (``oracle``) and evaluation
-    (``regime``) trials; ``study`` the ``oracle``, ``regime`` and ``ev`` (eval) sections and
-    the networks' ``targets``; ``settings`` (kept for the readers) at least ``bootstrap`` and
-    ``level``."""
+    (``regime``) trials; ``study`` the ``oracle``, ``regime`` and ``ev`` (eval) sections, the
+    ``protocol`` cell's planner settings and the networks' ``targets``; ``settings`` (kept
+    for the readers) at least ``bootstrap`` and ``level``."""
     oc, rc = study["oracle"], study["regime"]
     boot = (int(settings["bootstrap"]), float(settings["level"]))
     sel, ev = tables["oracle"], tables["regime"]
@@ -280,7 +280,7 @@ def analyze_study(tables: dict, study: dict, pairs: list[tuple[str, str]], setti
         "instances": int(ev["instance"].nunique()) if len(ev) else 0,
         "maps": sorted(int(c) for c in ev["cluster"].unique()) if len(ev) else [],
         "cell_names": list(dict.fromkeys(ev["regime"])) if len(ev) else [],
-        "regimes": d.regime_cells(rc) if rc else {},
+        "regimes": d.regime_cells(rc, study["protocol"]) if rc else {},
     }
 
 
