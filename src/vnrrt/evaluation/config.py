@@ -107,21 +107,6 @@ class Rules:
 
 
 @dataclass
-class StudyRules(Rules):
-    """:class:`Rules` and the planner settings a regime cell overrides (``planner.eta``,
-    ``radius_mode``, ``gamma_factor``, ``fixed_radius``, ``goal_radius``: their meaning in
-    :class:`~vnrrt.planners.config.PlannerConfig`), for stage ``ideas``, which plans nothing:
-    they say which grid cell is the protocol's own
-    (:func:`vnrrt.evaluation.sampling_ideas.design.protocol_settings`)."""
-
-    eta: float = 10.0
-    radius_mode: str = "shrinking"
-    gamma_factor: float = 1.0
-    fixed_radius: float = 10.0
-    goal_radius: float | None = None
-
-
-@dataclass
 class StatsConfig:
     """The ``stats`` section: bootstrap confidence intervals and the verdict rules."""
 

@@ -19,10 +19,25 @@ from pathlib import Path
 from omegaconf import DictConfig
 
 from vnrrt.config import ConfigError, check_parts, section, sections
-from vnrrt.evaluation.config import Configurations, OracleConfig, RegimeConfig
+from vnrrt.evaluation.config import Configurations, OracleConfig, RegimeConfig, Rules
 from vnrrt.paths import Paths
 
 log = logging.getLogger(__name__)
+
+
+@dataclass
+class StudyRules(Rules):
+    """:class:`~vnrrt.evaluation.config.Rules` and the planner settings a regime cell
+    overrides (``planner.eta``, ``radius_mode``, ``gamma_factor``, ``fixed_radius``,
+    ``goal_radius``: their meaning in :class:`~vnrrt.planners.config.PlannerConfig`), for
+    stage ``ideas``, which plans nothing: they say which grid cell is the protocol's own
+    (:func:`.design.protocol_settings`)."""
+
+    eta: float = 10.0
+    radius_mode: str = "shrinking"
+    gamma_factor: float = 1.0
+    fixed_radius: float = 10.0
+    goal_radius: float | None = None
 
 
 @dataclass(frozen=True)
@@ -103,7 +118,7 @@ def part_settings(cfg: DictConfig, which: str) -> dict:
 def ideas_settings(cfg: DictConfig) -> dict:
     """What stage ``ideas`` reads, typed (keyed by config section; ``protocol``: the
     protocol cell's planner settings, :func:`.design.protocol_settings`)."""
-    from vnrrt.evaluation.config import StatsConfig, StudyRules
+    from vnrrt.evaluation.config import StatsConfig
     from vnrrt.evaluation.sampling_ideas.design import protocol_settings
     from vnrrt.tracking import LoggerConfig
 
