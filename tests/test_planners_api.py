@@ -318,6 +318,62 @@ def same_run(a, b) -> bool:
 
 
 @pytest.mark.parametrize(
+    ("stop", "reference", "seed", "extra", "fast"),
+    [
+        ("initial", None, 0, {}, True),
+        ("initial", 30.0, 7, {}, True),
+        ("optimal", 30.0, 1, {}, True),
+        ("optimal", 6, 2, {}, True),  # an int reference
+        ("optimal", np.float64(30.0), 3, {}, False),  # not the common form: the general path
+        ("optimal", None, 4, {}, False),  # the reference computed (A*)
+        ("initial", None, 5, {"milestones": (3.0, 10.0)}, False),
+        ("initial", None, 6, {"keep_tree": True}, False),
+        ("initial", None, np.int64(8), {}, True),
+        ("initial", None, (8, 1), {}, True),
+        ("initial", None, (8, -1), {}, False),  # refused by the general path (a ValueError)
+        ("optimal", 5.0, 9, {}, False),  # the segment (5.39 px) above the bound: a search
+    ],
+)
+def test_a_free_segments_one_pass_answer_is_the_general_paths(
+    grid, heat, monkeypatch, stop, reference, seed, extra, fast
+):
+    """The one-pass answer to a free straight segment of plan() and of Planner.solve
+    (:func:`api._free_segment`) is the general path's (the query checked, then the run)
+    field by field, times apart; it is taken for the common form of the arguments only (the
+    general path is not entered then)."""
+    from vnrrt.planners import api
+
+    cfg = PlannerConfig(straight_first=True)
+    s, e = (10.5, 10.5), (15.5, 12.5)
+    ask = {"stop": stop, "reference_length": reference, "seed": seed, **extra}
+    ordered = (stop, reference, seed, extra.get("milestones", ()), extra.get("keep_tree", False))
+    if not api._seed_ok(seed):
+        with pytest.raises(ValueError, match="seed"):
+            plan(grid, s, e, config=cfg, **ask)
+        return
+    for planner, hm in (("rrt_star", None), ("vnrrt_star", np.zeros_like(heat))):
+        p = Planner(grid, planner, heatmap=hm, config=cfg)  # an all-zero heatmap: the fallback
+        query, tested = api._query(p.occ, cfg, s, e, *ordered, p.setup_time,
+                                   p.sampler.fallback_uniform)  # fmt: skip
+        general = p._run(query, seed, tested)
+        entered, real = [], api._query
+        monkeypatch.setattr(api, "_query", lambda *a, n=entered, q=real: n.append(1) or q(*a))
+        answers = [p.solve(s, e, **ask)]
+        if planner == "rrt_star":
+            answers.append(plan(grid, s, e, config=cfg, **ask))
+        monkeypatch.setattr(api, "_query", real)
+        assert len(entered) == (0 if fast else len(answers))
+        for r in answers:
+            assert same_run(r, general) and type(r.cost) is type(general.cost)
+            assert [m.bound for m in r.milestones] == [m.bound for m in general.milestones]
+            assert r.fallback_uniform is general.fallback_uniform is (planner == "vnrrt_star")
+            if fast:  # the straight answer: the one segment test timed
+                assert (r.iterations, r.tree_size) == (0, 2)
+                assert 0 < r.time_to_first == r.time_to_stop
+        assert answers[0].setup_time == p.setup_time  # plan()'s RRT*: 0, no sampler built
+
+
+@pytest.mark.parametrize(
     ("args", "kwargs", "error", "match"),
     [
         (((99.5, 50.5), (15.5, 12.5)), {}, GridError, "obstacle"),
@@ -437,3 +493,17 @@ def test_a_result_costs_exactly_its_paths_polyline_length(grid, seed):
     short = plan(grid, START, GOAL, seed=seed, config=PlannerConfig(max_iterations=1))
     assert not short.success and short.path.shape == (0, 2) and short.cost == math.inf
     assert short.first_cost == math.inf and short.trace_costs.size == 0
+
+
+def test_the_planners_results_hold_every_field_and_no_other(grid, heat):
+    """The planners build results without PlanResult.of's check of the keys
+    (:func:`vnrrt.planners.result.made`): a straight answer (both ways), a search, and
+    each with the tree kept hold exactly the dataclass's fields."""
+    from vnrrt.planners.result import FIELDS
+
+    cfg = PlannerConfig(straight_first=True)
+    vnrrt = Planner(grid, "vnrrt_star", heatmap=heat, config=cfg)
+    for keep in (False, True):
+        for s, e in (((10.5, 10.5), (15.5, 12.5)), (START, GOAL)):
+            for r in (plan(grid, s, e, config=cfg, keep_tree=keep), vnrrt.solve(s, e)):
+                assert r.__dict__.keys() == FIELDS

@@ -33,6 +33,7 @@ from vnrrt.planners.result import PlanResult
 from vnrrt.planners.samplers import Sampler, heatmap_sampler, rng_state, uniform_sampler
 
 log = logging.getLogger(__name__)
+UINT8 = np.dtype(np.uint8)  # the one uint8 dtype object: an identity test is the fast check
 
 DEFAULT = PlannerConfig()
 SAMPLER_KINDS = {
@@ -91,16 +92,13 @@ def check_sampler(
 
 
 def _occupancy(grid) -> np.ndarray:
-    """``grid`` as the core reads it: a C-contiguous 2-D uint8 array (at least 2x2) is used as
-    it is (nonzero = obstacle, no copy); anything else goes through :func:`as_occupancy`."""
-    if (
-        isinstance(grid, np.ndarray)
-        and grid.dtype == np.uint8
-        and grid.ndim == 2
-        and min(grid.shape) >= 2
-        and grid.flags.c_contiguous
-    ):
-        return grid
+    """``grid`` as the core reads it: a C-contiguous 2-D uint8 ``np.ndarray`` (at least 2x2;
+    not a subclass) is used as it is (nonzero = obstacle, no copy); anything else goes through
+    :func:`as_occupancy`."""
+    if type(grid) is np.ndarray and grid.dtype is UINT8 and grid.ndim == 2:
+        h, w = grid.shape
+        if h >= 2 and w >= 2 and grid.flags.c_contiguous:
+            return grid
     return as_occupancy(grid)
 
 
@@ -135,11 +133,64 @@ def _endpoints(occ: np.ndarray, start, goal, straight: bool):
     return start, goal, run.straight_test(occ, *start, *goal, straight)
 
 
-def _seed(seed) -> None:
-    if type(seed) is int and seed >= 0:  # the common case, checked fast
-        return
+def _free_segment(
+    occ: np.ndarray,
+    cfg: PlannerConfig,
+    start,
+    goal,
+    stop: str,
+    reference_length,
+    seed,
+    extras,
+    planner: str = "rrt_star",
+    setup_time: float = 0.0,
+    fallback: bool = False,
+) -> PlanResult | None:
+    """A solve's answer in one pass when ``cfg.straight_first`` holds, the straight segment is
+    free and meets the stop rule, and the arguments have the common form: points of two
+    numbers, ``stop`` ``'initial'`` or ``'optimal'`` with a ``reference_length`` (an int or
+    float, finite and >= 0; optional for ``'initial'``), a valid seed, no ``extras``
+    (milestones, the tree). None otherwise: then :func:`_query` checks the arguments (raising
+    their errors) and the run plans, as for a blocked segment or one above the stop bound
+    (tested again there, inside the run's time: ~1 us more per call that grows a tree).
+    ``planner``, ``setup_time`` and ``fallback`` go into the result, which is the general
+    path's field by field (times apart; tested), without that path's layers (the query, the
+    straight answer), each about a tenth of a call that one segment test answers."""
+    if extras or stop not in ("initial", "optimal") or not _seed_ok(seed):
+        return None
+    if reference_length is None:
+        if stop == "optimal":
+            return None  # the reference is computed: the general path
+        target = None
+    elif type(reference_length) in (float, int) and 0 <= reference_length < math.inf:
+        target = None if stop == "initial" else (1.0 + cfg.eps) * reference_length
+    else:
+        return None
+    try:
+        (sx, sy), (gx, gy) = start, goal
+        sx, sy, gx, gy = float(sx), float(sy), float(gx), float(gy)
+    except (TypeError, ValueError):
+        return None
+    if not math.isfinite(sx + sy + gx + gy):
+        return None
+    warmup()  # before the timed test: its kernel loaded
+    d, found = run.straight_test(occ, sx, sy, gx, gy, True)
+    if d < 0 or (target is not None and d > target):
+        return None  # blocked, an endpoint touching an obstacle, or above the bound
+    return run.straight_result(planner, d, found, (sx, sy), (gx, gy), target, (), False,
+                               reference_length, setup_time, fallback)  # fmt: skip
+
+
+def _seed_ok(seed) -> bool:
+    """Whether ``seed`` is an int >= 0 or a tuple (or list) of them."""
+    if type(seed) is int:  # the common case, checked fast
+        return seed >= 0
     parts = seed if isinstance(seed, tuple | list) else (seed,)
-    if not all(isinstance(s, numbers.Integral) and s >= 0 for s in parts):
+    return all(isinstance(s, numbers.Integral) and s >= 0 for s in parts)
+
+
+def _seed(seed) -> None:
+    if not _seed_ok(seed):
         raise ValueError(f"seed must be an int >= 0 or a tuple of them, got {seed!r}")
 
 
@@ -182,7 +233,7 @@ class Planner:
 
     Args:
         grid: ``(H, W)`` bool/int occupancy, nonzero = obstacle, indexed ``grid[y, x]``; a
-            C-contiguous uint8 array is read in place (do not change it while in use).
+            C-contiguous uint8 ``np.ndarray`` is read in place (do not change it while in use).
         planner: ``'rrt_star'`` (uniform), ``'nrrt_star'`` / ``'vnrrt_star'`` (heatmap
             sampler, Algorithm 2) or ``'m_vnrrt_star'`` (heatmap masked below ``config.tau``).
         heatmap: ``(H, W)`` non-negative sampling weights, needed by all but RRT*.
@@ -278,6 +329,12 @@ class Planner:
             NoPathError: the A* reference is needed and start and goal are not connected.
             ValueError: unknown stop rule, bad reference length or seed.
         """
+        if self.config.straight_first:
+            answer = _free_segment(self.occ, self.config, start, goal, stop, reference_length,
+                                   seed, milestones or keep_tree, self.planner, self.setup_time,
+                                   self.sampler.fallback_uniform)  # fmt: skip
+            if answer is not None:
+                return _logged(answer)
         ask = (stop, reference_length, seed, milestones, keep_tree)
         query, tested = _query(self.occ, self.config, start, goal, *ask, self.setup_time,
                                self.sampler.fallback_uniform)  # fmt: skip
@@ -348,6 +405,10 @@ def plan(
         config = _config(config)  # uniform sampling: the free segment needs no Planner
         if config.straight_first:
             grid = _occupancy(grid)
+            answer = _free_segment(grid, config, start, goal, stop, reference_length, seed,
+                                   milestones or keep_tree)  # fmt: skip
+            if answer is not None:
+                return _logged(answer)
             query, tested = _query(grid, config, start, goal, stop, reference_length, seed,
                                    milestones, keep_tree)  # fmt: skip
             answer = run.straight_answer(planner, query, tested)

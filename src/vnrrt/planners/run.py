@@ -23,7 +23,7 @@ import numpy as np
 from vnrrt.planners import clock, core, loop
 from vnrrt.planners import tree as nodes
 from vnrrt.planners.loop import FIRST_CHUNK, MAX_CHUNK
-from vnrrt.planners.result import Milestone, PlanResult
+from vnrrt.planners.result import Milestone, PlanResult, made
 
 FIRST_CAPACITY = 4096  # tree nodes allocated first; doubled when full (up to the budget)
 
@@ -181,43 +181,73 @@ def straight_answer(planner: str, query: Query, tested: tuple[float, float]) -> 
     (a tree is needed)."""
     d, found = tested
     if d >= 0 and (query.target is None or d <= query.target):
-        return straight_result(planner, query, d, found)
+        return straight_result(planner, d, found, *query)
     return None
 
 
-def straight_result(planner: str, query: Query, d: float, found: float) -> PlanResult:
+def straight_result(
+    planner: str,
+    d: float,
+    found: float,
+    start: tuple[float, float],
+    goal: tuple[float, float],
+    target: float | None,
+    bounds: tuple = (),
+    keep_tree: bool = False,
+    reference_length: float | None = None,
+    setup_time: float = 0.0,
+    fallback_uniform: bool = False,
+) -> PlanResult:
     """The result of a run answered after ``found`` seconds by the free straight segment of
-    length ``d``: the tree is the root and the goal joined to it (one segment test). The
-    cost is ``d``, equal to the polyline length of the path (both are libm's ``hypot``)."""
-    path = np.array((query.start, query.goal))
-    extra = (
-        tuple(Milestone(b, found, 0) if d <= b else Milestone(b) for b in query.bounds)
-        if query.bounds
-        else ()
-    )
-    return PlanResult.of({
-        "planner": planner,
-        "success": True,
-        "stop_reason": "solved",
-        "path": path,
-        "cost": d,
-        "iterations": 0,
-        "tree_size": 2,
-        "collision_checks": 1,
-        "time_to_first": found,
-        "time_to_stop": found,
-        "first_cost": d,
-        "first_iteration": 0,
-        "trace_iterations": np.zeros(1, np.int64),
-        "trace_costs": np.array([d]),
-        "reference_length": query.reference_length,
-        "target_cost": query.target,
-        "milestones": extra,
-        "fallback_uniform": query.fallback_uniform,
-        "setup_time": query.setup_time,
-        "tree_points": path.copy() if query.keep_tree else None,
-        "tree_parents": np.array([-1, 0], np.int64) if query.keep_tree else None,
-    })  # fmt: skip
+    length ``d`` from ``start`` to ``goal``, the other arguments those of its
+    :class:`Query` (in its order): the tree is the root and the goal joined to it (one
+    segment test). The cost is ``d``, equal to the polyline length of the path (both are
+    libm's ``hypot``)."""
+    path = np.array((start, goal))
+    values = STRAIGHT.copy()  # the fields every straight answer shares, then its own
+    values["planner"] = planner
+    values["path"] = path
+    values["cost"] = values["first_cost"] = d
+    values["time_to_first"] = values["time_to_stop"] = found
+    values["trace_iterations"] = ROOT_TRACE.copy()
+    values["trace_costs"] = np.array((d,))
+    values["reference_length"] = reference_length
+    values["target_cost"] = target
+    values["fallback_uniform"] = fallback_uniform
+    values["setup_time"] = setup_time
+    if bounds:
+        values["milestones"] = tuple(Milestone(b, found, 0) if d <= b else Milestone(b)
+                                     for b in bounds)  # fmt: skip
+    if keep_tree:
+        values["tree_points"] = path.copy()
+        values["tree_parents"] = np.array((-1, 0), np.int64)
+    return made(values)
+
+
+STRAIGHT = {
+    "planner": "",
+    "success": True,
+    "stop_reason": "solved",
+    "path": None,
+    "cost": 0.0,
+    "iterations": 0,
+    "tree_size": 2,
+    "collision_checks": 1,
+    "time_to_first": 0.0,
+    "time_to_stop": 0.0,
+    "first_cost": 0.0,
+    "first_iteration": 0,
+    "trace_iterations": None,
+    "trace_costs": None,
+    "reference_length": None,
+    "target_cost": None,
+    "milestones": (),
+    "fallback_uniform": False,
+    "setup_time": 0.0,
+    "tree_points": None,
+    "tree_parents": None,
+}  # a straight answer's fields (:func:`straight_result` sets those that vary); a copy per result
+ROOT_TRACE = np.zeros(1, np.int64)  # a straight answer's trace iterations (copied per result)
 
 
 def search(
@@ -344,7 +374,7 @@ def result(
         tree.links, tree.pts, tree.cost, g, trace.iters, trace.costs, k, int(c.iters[0])
     )
     first_time, first_iter = reached[math.inf]
-    return PlanResult.of({
+    return made({
         "planner": planner,
         "success": reason == "solved",
         "stop_reason": reason,
