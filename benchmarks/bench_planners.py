@@ -27,7 +27,14 @@ Every path of ours is checked with the exact segment test and against the stop r
 if one fails); OMPL's paths that clip an obstacle corner under that test are counted. Exit 2
 when the harness cannot be built. OMPL's Python bindings run with the garbage collector on.
 
+By default our first call of a trial follows the Python bindings' runs of the one before, so its
+caches are cold (a free straight segment's run, one segment test of ~1 us warm, then reads ~10
+us), while each native planner follows the others' runs on the same map in its harness.
+``--warm SECONDS`` precedes every timed run, ours and OMPL's alike, by an untimed run of the
+same planner and query with that budget (a second reading, not the default).
+
     python benchmarks/bench_planners.py [--trials 5] [--time-limit 2] [--sets dev,held_out]
+        [--warm 0.001]
 """
 
 from __future__ import annotations
@@ -53,6 +60,7 @@ PYTHON = [*ompl_python.PLANNERS, "RRTstar-m", "InformedRRTstar-m"]
 
 
 COLLECT_BEFORE = False  # --collect-before: the method of the runs before 2026-12-02 (see main)
+WARM = 0.0  # --warm: seconds of an untimed run of each planner before each of its timed ones
 
 
 def run_ours(g, s, e, exact, seed, config) -> dict:
@@ -107,11 +115,17 @@ def bench_map(native, g, s, e, trials, limit, seed, python) -> dict:
     for k in range(trials):
         for label, config in OURS.items():
             config = config.replace(max_seconds=limit)  # validated here, not in the timed call
+            if WARM:
+                run_ours(g, s, e, exact, (*seed, k, 1), config.replace(max_seconds=WARM))
             runs.setdefault(label, []).append(run_ours(g, s, e, exact, (*seed, k), config))
         gc.collect()  # our calls' garbage, outside every timed call
         for name in NATIVE:
+            if WARM:
+                run_native(native, g, s, e, bound, WARM, name)
             runs.setdefault(f"n-{name}", []).append(run_native(native, g, s, e, bound, limit, name))
         for name in PYTHON if python else ():
+            if WARM:
+                run_python(g, s, e, bound, WARM, name)
             runs.setdefault(f"p-{name}", []).append(run_python(g, s, e, bound, limit, name))
     return {"exact": exact, "floor": floor_seconds(g, s, e), "runs": runs}
 
@@ -221,9 +235,13 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--collect-before", action="store_true",
                     help="collect garbage right before each of our calls (the runs before "
                          "2026-12-02: it leaves the next call's caches cold)")  # fmt: skip
+    ap.add_argument("--warm", type=float, default=0.0, metavar="SECONDS",
+                    help="before each timed run, an untimed run of the same planner and query "
+                         "with this budget (every planner, ours and OMPL's, starts warm, as in a "
+                         "process answering a stream of queries; default 0: none)")  # fmt: skip
     args = ap.parse_args(argv)
-    global COLLECT_BEFORE
-    COLLECT_BEFORE = args.collect_before
+    global COLLECT_BEFORE, WARM
+    COLLECT_BEFORE, WARM = args.collect_before, args.warm
     binary = ompl_native.build_or_explain()
     if binary is None:
         return 2
