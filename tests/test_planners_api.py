@@ -328,6 +328,7 @@ def same_run(a, b) -> bool:
         ("optimal", None, 4, {}, False),  # the reference computed (A*)
         ("initial", None, 5, {"milestones": (3.0, 10.0)}, False),
         ("initial", None, 6, {"keep_tree": True}, False),
+        ("initial", None, 6, {"milestones": np.array([3.0, 10.0])}, None),  # an error, as before
         ("initial", None, np.int64(8), {}, True),
         ("initial", None, (8, 1), {}, True),
         ("initial", None, (8, -1), {}, False),  # refused by the general path (a ValueError)
@@ -347,9 +348,11 @@ def test_a_free_segments_one_pass_answer_is_the_general_paths(
     s, e = (10.5, 10.5), (15.5, 12.5)
     ask = {"stop": stop, "reference_length": reference, "seed": seed, **extra}
     ordered = (stop, reference, seed, extra.get("milestones", ()), extra.get("keep_tree", False))
-    if not api._seed_ok(seed):
-        with pytest.raises(ValueError, match="seed"):
+    if not api._seed_ok(seed) or fast is None:
+        with pytest.raises(ValueError, match="seed|ambiguous"):
             plan(grid, s, e, config=cfg, **ask)
+        with pytest.raises(GridError):  # the points checked first: the general path's order
+            plan(grid, s, (99.5, 50.5), config=cfg, **ask)
         return
     for planner, hm in (("rrt_star", None), ("vnrrt_star", np.zeros_like(heat))):
         p = Planner(grid, planner, heatmap=hm, config=cfg)  # an all-zero heatmap: the fallback

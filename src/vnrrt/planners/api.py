@@ -141,7 +141,8 @@ def _free_segment(
     stop: str,
     reference_length,
     seed,
-    extras,
+    milestones,
+    keep_tree,
     planner: str = "rrt_star",
     setup_time: float = 0.0,
     fallback: bool = False,
@@ -149,14 +150,17 @@ def _free_segment(
     """A solve's answer in one pass when ``cfg.straight_first`` holds, the straight segment is
     free and meets the stop rule, and the arguments have the common form: points of two
     numbers, ``stop`` ``'initial'`` or ``'optimal'`` with a ``reference_length`` (an int or
-    float, finite and >= 0; optional for ``'initial'``), a valid seed, no ``extras``
-    (milestones, the tree). None otherwise: then :func:`_query` checks the arguments (raising
-    their errors) and the run plans, as for a blocked segment or one above the stop bound
-    (tested again there, inside the run's time: ~1 us more per call that grows a tree).
-    ``planner``, ``setup_time`` and ``fallback`` go into the result, which is the general
-    path's field by field (times apart; tested), without that path's layers (the query, the
-    straight answer), each about a tenth of a call that one segment test answers."""
-    if extras or stop not in ("initial", "optimal") or not _seed_ok(seed):
+    float, finite and >= 0; optional for ``'initial'``), a valid seed, ``milestones`` the
+    empty tuple and ``keep_tree`` false. None otherwise: then :func:`_query` checks the
+    arguments (raising their errors, in its order) and the run plans, as for a blocked segment
+    or one above the stop bound (tested again there, in the run's timed region: the first test
+    adds ~1 us to such a call, outside its run). ``planner``, ``setup_time`` and ``fallback``
+    go into the result, which is the general path's field by field (times apart; tested),
+    without that path's layers (the query, the straight answer), each about a tenth of a call
+    that one segment test answers."""
+    if keep_tree or type(milestones) is not tuple or milestones:
+        return None
+    if stop not in ("initial", "optimal") or not _seed_ok(seed):
         return None
     if reference_length is None:
         if stop == "optimal":
@@ -331,7 +335,7 @@ class Planner:
         """
         if self.config.straight_first:
             answer = _free_segment(self.occ, self.config, start, goal, stop, reference_length,
-                                   seed, milestones or keep_tree, self.planner, self.setup_time,
+                                   seed, milestones, keep_tree, self.planner, self.setup_time,
                                    self.sampler.fallback_uniform)  # fmt: skip
             if answer is not None:
                 return _logged(answer)
@@ -406,7 +410,7 @@ def plan(
         if config.straight_first:
             grid = _occupancy(grid)
             answer = _free_segment(grid, config, start, goal, stop, reference_length, seed,
-                                   milestones or keep_tree)  # fmt: skip
+                                   milestones, keep_tree)  # fmt: skip
             if answer is not None:
                 return _logged(answer)
             query, tested = _query(grid, config, start, goal, stop, reference_length, seed,
