@@ -105,9 +105,9 @@ FIELDS = frozenset(f.name for f in fields(PlanResult))
 
 def made(values: dict) -> PlanResult:
     """:meth:`PlanResult.of` without its check of the keys: for the planners' own result
-    builders (:mod:`.run`), whose dicts name every field (tested), in the few microseconds
-    of a solve that one segment test answers, where the check's set comparison alone is a
-    tenth of the call. ``values`` becomes the result's ``__dict__``."""
+    builders (:mod:`.run`), whose dicts name every field (tested): in a solve that one
+    segment test answers (~4-5 us), the check's set comparison alone is ~0.3 us. ``values``
+    becomes the result's ``__dict__``."""
     result = object.__new__(PlanResult)
     object.__setattr__(result, "__dict__", values)
     return result
