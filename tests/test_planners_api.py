@@ -1,5 +1,6 @@
 """plan(): paths, costs, stop rules and determinism against independent references."""
 
+import functools
 import itertools
 import math
 
@@ -360,7 +361,9 @@ def test_a_free_segments_one_pass_answer_is_the_general_paths(
                                    p.sampler.fallback_uniform)  # fmt: skip
         general = p._run(query, seed, tested)
         entered, real = [], api._query
-        monkeypatch.setattr(api, "_query", lambda *a, n=entered, q=real: n.append(1) or q(*a))
+        monkeypatch.setattr(
+            api, "_query", lambda *a, n=entered, q=real, **k: n.append(1) or q(*a, **k)
+        )
         answers = [p.solve(s, e, **ask)]
         if planner == "rrt_star":
             answers.append(plan(grid, s, e, config=cfg, **ask))
@@ -510,3 +513,18 @@ def test_the_planners_results_hold_every_field_and_no_other(grid, heat):
         for s, e in (((10.5, 10.5), (15.5, 12.5)), (START, GOAL)):
             for r in (plan(grid, s, e, config=cfg, keep_tree=keep), vnrrt.solve(s, e)):
                 assert r.__dict__.keys() == FIELDS
+
+
+def test_a_blocked_straight_segment_is_tested_once(grid, monkeypatch):
+    """A query whose straight segment is blocked goes from the one-pass check to the search
+    with the segment tested once (the general path reuses that test), by plan() and
+    Planner.solve alike, with the same result as before."""
+    cfg = PlannerConfig(straight_first=True)
+    before = plan(grid, START, GOAL, config=cfg, stop="optimal", reference_length=200.0)
+    calls, real = [], run.straight_test
+    monkeypatch.setattr(run, "straight_test", lambda *a: calls.append(a) or real(*a))
+    p = Planner(grid, config=cfg)
+    for solve in (functools.partial(plan, grid, config=cfg), p.solve):
+        calls.clear()
+        r = solve(START, GOAL, stop="optimal", reference_length=200.0)
+        assert len(calls) == 1 and r.iterations > 0 and same_run(r, before)

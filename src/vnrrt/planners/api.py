@@ -115,20 +115,26 @@ def _endpoint(occ: np.ndarray, point, name: str) -> tuple[float, float]:
     raise GridError(f"{name} {(x, y)} touches an obstacle cell or the map border")
 
 
+def _floats(start, goal) -> tuple[float, float, float, float] | None:
+    """``(sx, sy, gx, gy)`` as floats when ``start`` and ``goal`` are each two finite numbers,
+    else None."""
+    try:
+        (sx, sy), (gx, gy) = start, goal
+        sx, sy, gx, gy = float(sx), float(sy), float(gx), float(gy)
+    except (TypeError, ValueError):
+        return None
+    return (sx, sy, gx, gy) if math.isfinite(sx + sy + gx + gy) else None
+
+
 def _endpoints(occ: np.ndarray, start, goal, straight: bool):
     """:func:`_endpoint` of both points, and :func:`run.straight_test`'s answer (the
     straight segment tested when ``straight``): valid points are checked in that one
     compiled call. Returns ``(start, goal, tested)``."""
-    try:
-        (sx, sy), (gx, gy) = start, goal
-        sx, sy, gx, gy = float(sx), float(sy), float(gx), float(gy)
-        finite = math.isfinite(sx + sy + gx + gy)
-    except (TypeError, ValueError):
-        finite = False
-    if finite:
-        tested = run.straight_test(occ, sx, sy, gx, gy, straight)
+    xy = _floats(start, goal)
+    if xy is not None:
+        tested = run.straight_test(occ, *xy, straight)
         if tested[0] != core.BAD_ENDPOINT:
-            return (sx, sy), (gx, gy), tested
+            return xy[:2], xy[2:], tested
     start, goal = _endpoint(occ, start, "start"), _endpoint(occ, goal, "goal")  # one raises
     return start, goal, run.straight_test(occ, *start, *goal, straight)
 
@@ -146,43 +152,45 @@ def _free_segment(
     planner: str = "rrt_star",
     setup_time: float = 0.0,
     fallback: bool = False,
-) -> PlanResult | None:
+) -> tuple[PlanResult | None, tuple | None]:
     """A solve's answer in one pass when ``cfg.straight_first`` holds, the straight segment is
     free and meets the stop rule, and the arguments have the common form: points of two
     numbers, ``stop`` ``'initial'`` or ``'optimal'`` with a ``reference_length`` (an int or
     float, finite and >= 0; optional for ``'initial'``), a valid seed, ``milestones`` the
-    empty tuple and ``keep_tree`` false. None otherwise: then :func:`_query` checks the
-    arguments (raising their errors, in its order) and the run plans, as for a blocked segment
-    or one above the stop bound (tested again there, in the run's timed region: the first test
-    adds ~1 us to such a call, outside its run). ``planner``, ``setup_time`` and ``fallback``
-    go into the result, which is the general path's field by field (times apart; tested),
-    without that path's layers (the query, the straight answer), each about a tenth of a call
-    that one segment test answers."""
+    empty tuple and ``keep_tree`` false. ``planner``, ``setup_time`` and ``fallback`` go into
+    the result, which is the general path's field by field (times apart; tested), without
+    that path's layers (the query, the straight answer), each about a tenth of a call that
+    one segment test answers.
+
+    Returns ``(result, None)``, or ``(None, known)`` when the general path must answer
+    (:func:`_query` then checks the arguments, raising their errors in its order, and the run
+    plans): ``known`` is :func:`_endpoints`' ``(start, goal, tested)`` when the points passed
+    the compiled test here (a blocked segment, one above the stop bound: ``_query`` reuses
+    it, so the segment is tested once), else None."""
     if keep_tree or type(milestones) is not tuple or milestones:
-        return None
+        return None, None
     if stop not in ("initial", "optimal") or not _seed_ok(seed):
-        return None
+        return None, None
     if reference_length is None:
         if stop == "optimal":
-            return None  # the reference is computed: the general path
+            return None, None  # the reference is computed: the general path
         target = None
     elif type(reference_length) in (float, int) and 0 <= reference_length < math.inf:
         target = None if stop == "initial" else (1.0 + cfg.eps) * reference_length
     else:
-        return None
-    try:
-        (sx, sy), (gx, gy) = start, goal
-        sx, sy, gx, gy = float(sx), float(sy), float(gx), float(gy)
-    except (TypeError, ValueError):
-        return None
-    if not math.isfinite(sx + sy + gx + gy):
-        return None
+        return None, None
+    xy = _floats(start, goal)
+    if xy is None:
+        return None, None
+    sx, sy, gx, gy = xy
     warmup()  # before the timed test: its kernel loaded
-    d, found = run.straight_test(occ, sx, sy, gx, gy, True)
-    if d < 0 or (target is not None and d > target):
-        return None  # blocked, an endpoint touching an obstacle, or above the bound
+    tested = run.straight_test(occ, sx, sy, gx, gy, True)
+    d, found = tested
+    if d < 0 or (target is not None and d > target):  # blocked or above the bound: a tree;
+        bad = d == core.BAD_ENDPOINT  # an endpoint touching an obstacle: _query names it
+        return None, None if bad else ((sx, sy), (gx, gy), tested)
     return run.straight_result(planner, d, found, (sx, sy), (gx, gy), target, (), False,
-                               reference_length, setup_time, fallback)  # fmt: skip
+                               reference_length, setup_time, fallback), None  # fmt: skip
 
 
 def _seed_ok(seed) -> bool:
@@ -206,13 +214,14 @@ def _logged(result: PlanResult) -> PlanResult:
 
 
 def _query(occ: np.ndarray, cfg: PlannerConfig, start, goal, stop: str, reference_length,
-           seed, milestones, keep_tree: bool, setup_time: float = 0.0,
-           fallback: bool = False) -> tuple[run.Query, tuple[float, float]]:  # fmt: skip
+           seed, milestones, keep_tree: bool, setup_time: float = 0.0, fallback: bool = False,
+           known: tuple | None = None) -> tuple[run.Query, tuple[float, float]]:  # fmt: skip
     """The validated query of a solve (arguments and errors: :meth:`Planner.solve`), the
     compiled kernels loaded (:func:`warmup`), and the straight segment's test when
-    ``cfg.straight_first`` (:func:`run.straight_test`; made with the endpoints' checks)."""
+    ``cfg.straight_first`` (:func:`run.straight_test`; made with the endpoints' checks);
+    ``known``: :func:`_endpoints`' answer, already made by :func:`_free_segment`."""
     warmup()  # before the straight segment's timed test: its kernel loaded
-    start, goal, tested = _endpoints(occ, start, goal, cfg.straight_first)
+    start, goal, tested = known or _endpoints(occ, start, goal, cfg.straight_first)
     if stop not in ("initial", "optimal"):
         raise ValueError(f"unknown stop rule {stop!r}; use 'initial' or 'optimal'")
     _seed(seed)
@@ -333,15 +342,17 @@ class Planner:
             NoPathError: the A* reference is needed and start and goal are not connected.
             ValueError: unknown stop rule, bad reference length or seed.
         """
+        known = None
         if self.config.straight_first:
-            answer = _free_segment(self.occ, self.config, start, goal, stop, reference_length,
-                                   seed, milestones, keep_tree, self.planner, self.setup_time,
-                                   self.sampler.fallback_uniform)  # fmt: skip
+            answer, known = _free_segment(self.occ, self.config, start, goal, stop,
+                                          reference_length, seed, milestones, keep_tree,
+                                          self.planner, self.setup_time,
+                                          self.sampler.fallback_uniform)  # fmt: skip
             if answer is not None:
                 return _logged(answer)
         ask = (stop, reference_length, seed, milestones, keep_tree)
         query, tested = _query(self.occ, self.config, start, goal, *ask, self.setup_time,
-                               self.sampler.fallback_uniform)  # fmt: skip
+                               self.sampler.fallback_uniform, known)  # fmt: skip
         return self._run(query, seed, tested)
 
     def _run(self, query: run.Query, seed, tested: tuple[float, float]) -> PlanResult:
@@ -409,12 +420,12 @@ def plan(
         config = _config(config)  # uniform sampling: the free segment needs no Planner
         if config.straight_first:
             grid = _occupancy(grid)
-            answer = _free_segment(grid, config, start, goal, stop, reference_length, seed,
-                                   milestones, keep_tree)  # fmt: skip
+            answer, known = _free_segment(grid, config, start, goal, stop, reference_length,
+                                          seed, milestones, keep_tree)  # fmt: skip
             if answer is not None:
                 return _logged(answer)
             query, tested = _query(grid, config, start, goal, stop, reference_length, seed,
-                                   milestones, keep_tree)  # fmt: skip
+                                   milestones, keep_tree, known=known)  # fmt: skip
             answer = run.straight_answer(planner, query, tested)
             if answer is not None:
                 return _logged(answer)
