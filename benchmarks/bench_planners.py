@@ -27,14 +27,20 @@ Every path of ours is checked with the exact segment test and against the stop r
 if one fails); OMPL's paths that clip an obstacle corner under that test are counted. Exit 2
 when the harness cannot be built. OMPL's Python bindings run with the garbage collector on.
 
-By default our first call of a trial follows the Python bindings' runs of the one before, so its
-caches are cold (a free straight segment's run, one segment test of ~1 us warm, then reads ~10
-us), while each native planner follows the others' runs on the same map in its harness.
-``--warm SECONDS`` precedes every timed run, ours and OMPL's alike, by an untimed run of the
-same planner and query with that budget (a second reading, not the default).
+Every timed run, ours and OMPL's alike, follows an untimed run of the same planner and query
+with a 1 ms budget (``--warm SECONDS``), as each of OMPL's runs follows the same planner's run in
+OMPL's own benchmark tool (``ompl::tools::Benchmark::benchmark``: planners in the outer loop,
+runs in the inner one), while trials still alternate between the planners. ``--warm 0`` is the
+default before 2026-12-03 (a second reading): there our first call of a trial follows the
+Python bindings' runs of the one before, with cold caches (a free straight segment's run, one
+segment test of ~1 us warm, then reads ~10 us), while each native planner follows the others'
+runs on the same map and its own setup in its harness, warmer. ``--flush MB`` (a third reading,
+with ``--warm 0``) writes and reads that many MB of a buffer in the planner's own process (ours
+and the Python bindings' here, native OMPL's in its harness) right before every timed run, so
+that every planner starts from caches evicted alike.
 
     python benchmarks/bench_planners.py [--trials 5] [--time-limit 2] [--sets dev,held_out]
-        [--warm 0.001]
+        [--warm 0.001] [--flush 0]
 """
 
 from __future__ import annotations
@@ -60,7 +66,19 @@ PYTHON = [*ompl_python.PLANNERS, "RRTstar-m", "InformedRRTstar-m"]
 
 
 COLLECT_BEFORE = False  # --collect-before: the method of the runs before 2026-12-02 (see main)
-WARM = 0.0  # --warm: seconds of an untimed run of each planner before each of its timed ones
+WARM = 0.001  # --warm: seconds of an untimed run of each planner before each of its timed ones
+FLUSH = 0  # --flush: bytes written and read in a planner's process before each of its timed runs
+_BUFFER = np.zeros(0, np.uint8)  # this process's flush buffer
+
+
+def flush_here(nbytes: int) -> int:
+    """Write and read ``nbytes`` bytes (every 64-byte line) of a buffer kept for the purpose,
+    evicting the CPU caches of this process's next run; returns the sum read."""
+    global _BUFFER
+    if _BUFFER.size != nbytes:
+        _BUFFER = np.zeros(nbytes, np.uint8)
+    _BUFFER[::64] += 1
+    return int(_BUFFER[::64].sum())
 
 
 def run_ours(g, s, e, exact, seed, config) -> dict:
@@ -117,15 +135,21 @@ def bench_map(native, g, s, e, trials, limit, seed, python) -> dict:
             config = config.replace(max_seconds=limit)  # validated here, not in the timed call
             if WARM:
                 run_ours(g, s, e, exact, (*seed, k, 1), config.replace(max_seconds=WARM))
+            if FLUSH:
+                flush_here(FLUSH)
             runs.setdefault(label, []).append(run_ours(g, s, e, exact, (*seed, k), config))
         gc.collect()  # our calls' garbage, outside every timed call
         for name in NATIVE:
             if WARM:
                 run_native(native, g, s, e, bound, WARM, name)
+            if FLUSH:
+                native.flush(FLUSH)
             runs.setdefault(f"n-{name}", []).append(run_native(native, g, s, e, bound, limit, name))
         for name in PYTHON if python else ():
             if WARM:
                 run_python(g, s, e, bound, WARM, name)
+            if FLUSH:
+                flush_here(FLUSH)
             runs.setdefault(f"p-{name}", []).append(run_python(g, s, e, bound, limit, name))
     return {"exact": exact, "floor": floor_seconds(g, s, e), "runs": runs}
 
@@ -235,13 +259,19 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--collect-before", action="store_true",
                     help="collect garbage right before each of our calls (the runs before "
                          "2026-12-02: it leaves the next call's caches cold)")  # fmt: skip
-    ap.add_argument("--warm", type=float, default=0.0, metavar="SECONDS",
+    ap.add_argument("--warm", type=float, default=0.001, metavar="SECONDS",
                     help="before each timed run, an untimed run of the same planner and query "
-                         "with this budget (every planner, ours and OMPL's, starts warm, as in a "
-                         "process answering a stream of queries; default 0: none)")  # fmt: skip
+                         "with this budget (every planner, ours and OMPL's, starts warm, as each "
+                         "run in OMPL's benchmark tool follows the same planner's; 0: none, the "
+                         "default before 2026-12-03)")  # fmt: skip
+    flush = "before each timed run (after --warm's), write and read this many MB in the "
+    flush += "planner's process: every planner starts with evicted caches"
+    ap.add_argument("--flush", type=float, default=0.0, metavar="MB", help=flush)
     args = ap.parse_args(argv)
-    global COLLECT_BEFORE, WARM
-    COLLECT_BEFORE, WARM = args.collect_before, args.warm
+    if args.warm < 0 or args.flush < 0:
+        ap.error("--warm and --flush must be >= 0")
+    global COLLECT_BEFORE, WARM, FLUSH
+    COLLECT_BEFORE, WARM, FLUSH = args.collect_before, args.warm, int(args.flush * 2**20)
     binary = ompl_native.build_or_explain()
     if binary is None:
         return 2

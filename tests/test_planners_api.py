@@ -528,3 +528,21 @@ def test_a_blocked_straight_segment_is_tested_once(grid, monkeypatch):
         calls.clear()
         r = solve(START, GOAL, stop="optimal", reference_length=200.0)
         assert len(calls) == 1 and r.iterations > 0 and same_run(r, before)
+
+
+SEEDS = (0, 7, -1, (), (1, 2), (1, -2), (0, 2**70), (True, 1), (np.int64(3), 1), [1, 2],
+         [1, -1], (1.0,), ("a",), np.int64(2), np.int64(-2), True, 1.0, None, ((1,),))  # fmt: skip
+
+
+@pytest.mark.parametrize("seed", SEEDS, ids=repr)
+def test_the_seed_checks_fast_paths_agree_with_its_definition(seed):
+    """``_seed_ok``'s fast paths (an int; a tuple of ints) answer as the definition does: an
+    integer >= 0, or a tuple or list of them (numbers.Integral, so bools and numpy ints
+    too)."""
+    import numbers
+
+    from vnrrt.planners import api
+
+    parts = seed if isinstance(seed, tuple | list) else (seed,)
+    expected = all(isinstance(s, numbers.Integral) and s >= 0 for s in parts)
+    assert api._seed_ok(seed) is expected

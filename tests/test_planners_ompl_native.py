@@ -57,3 +57,21 @@ def test_an_unknown_planner_is_refused(binary):
         native.set_map(np.zeros((10, 10), np.uint8))
         with pytest.raises(ompl_native.HarnessError, match="unknown planner"):
             native.solve("PRMstar", (1.5, 1.5), (8.5, 8.5), bound=math.inf, limit=0.1)
+
+
+def test_a_flush_is_answered_and_leaves_the_next_solve_as_it_was(binary):
+    """``flush`` (the benchmark's --flush) answers, refuses a negative size, and the solve
+    after it, with the harness's RNG seeded alike, gives the same path as without it."""
+    g = np.zeros((20, 20), np.uint8)
+    g[5:15, 10] = 1
+    paths = []
+    for flush in (0, 1 << 20):
+        with ompl_native.Harness(binary, seed=5) as native:
+            native.set_map(g)
+            native.flush(flush)
+            paths.append(native.solve("BITstar", (2.5, 10.5), (17.5, 10.5), bound=30.0,
+                                      limit=1.0).path)  # fmt: skip
+            with pytest.raises(ompl_native.HarnessError, match="flush"):
+                native.flush(-1)
+    assert len(paths[0]) >= 3  # around the wall
+    np.testing.assert_array_equal(paths[0], paths[1])

@@ -123,6 +123,14 @@ class Harness:
         cells = "".join(np.where(g.ravel(), "1", "0"))
         self._proc.stdin.write(f"map {g.shape[0]} {g.shape[1]} {cells}\n")
 
+    def flush(self, nbytes: int) -> None:
+        """Write and read ``nbytes`` bytes of a buffer in the harness process (evicting the
+        CPU caches its next solve would find warm), and wait for its answer."""
+        self._proc.stdin.write(f"flush {int(nbytes)}\n")
+        answer = self._proc.stdout.readline().strip()
+        if not answer.startswith("flushed"):
+            raise HarnessError(f"the harness answered {answer!r} to a flush")
+
     def solve(self, planner: str, start, goal, bound: float, limit: float,
               step: float = 0.0) -> NativeRun:  # fmt: skip
         """Run ``planner`` (one of :data:`PLANNERS`) until its cost reaches ``bound`` px or

@@ -8,6 +8,8 @@
 //                          RANGE: the Steer step in pixels (0: OMPL's default);
 //                          start and goal (x, y) in pixels; BOUND: the cost threshold at
 //                          which the planner stops; LIMIT: seconds
+//   flush BYTES            write and read BYTES bytes of a buffer of its own (evicting the
+//                          CPU caches the following solve would find warm); answers "flushed"
 //   quit
 // Answer: "first=S stop=S setup=S cost=C path=X,Y;X,Y;..." with S in seconds since solve()
 // began (nan: not reached), setup the seconds spent building space, problem and planner
@@ -143,6 +145,18 @@ static std::string solve(const Grid &g, std::istringstream &in) {
     return out.str();
 }
 
+// Writes and reads `bytes` bytes of a buffer kept for the purpose; the sum keeps the reads.
+static std::string flush(std::istringstream &in) {
+    static std::vector<unsigned char> buffer;
+    long long bytes = -1;
+    if (!(in >> bytes) || bytes < 0) throw std::invalid_argument("flush expects BYTES >= 0");
+    buffer.resize(static_cast<size_t>(bytes));
+    unsigned sum = 0;
+    for (size_t i = 0; i < buffer.size(); i += 64) buffer[i] = static_cast<unsigned char>(i);
+    for (size_t i = 0; i < buffer.size(); i += 64) sum += buffer[i];
+    return "flushed " + std::to_string(sum);
+}
+
 static Grid read_map(std::istringstream &in) {
     Grid g;
     std::string cells;
@@ -168,6 +182,8 @@ int main(int argc, char **argv) {
                 grid = read_map(in);
             } else if (cmd == "solve") {
                 std::cout << solve(grid, in) << std::endl;
+            } else if (cmd == "flush") {
+                std::cout << flush(in) << std::endl;
             } else if (cmd == "quit") {
                 break;
             } else if (!cmd.empty()) {

@@ -195,8 +195,14 @@ def _free_segment(
 
 def _seed_ok(seed) -> bool:
     """Whether ``seed`` is an int >= 0 or a tuple (or list) of them."""
-    if type(seed) is int:  # the common case, checked fast
+    if type(seed) is int:  # the common cases, checked fast: an int, a tuple of ints
         return seed >= 0
+    if type(seed) is tuple:  # (~0.1 us; numbers.Integral's isinstance is ~0.3 us a part)
+        for s in seed:
+            if type(s) is not int or s < 0:
+                break  # another kind of part (a bool, a numpy int) or a negative one
+        else:
+            return True
     parts = seed if isinstance(seed, tuple | list) else (seed,)
     return all(isinstance(s, numbers.Integral) and s >= 0 for s in parts)
 
