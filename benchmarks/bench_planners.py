@@ -28,16 +28,19 @@ if one fails); OMPL's paths that clip an obstacle corner under that test are cou
 when the harness cannot be built. OMPL's Python bindings run with the garbage collector on.
 
 Every timed run, ours and OMPL's alike, follows an untimed run of the same planner and query
-with a 1 ms budget (``--warm SECONDS``), as each of OMPL's runs follows the same planner's run in
-OMPL's own benchmark tool (``ompl::tools::Benchmark::benchmark``: planners in the outer loop,
-runs in the inner one), while trials still alternate between the planners. ``--warm 0`` is the
-default before 2026-12-03 (a second reading): there our first call of a trial follows the
-Python bindings' runs of the one before, with cold caches (a free straight segment's run, one
-segment test of ~1 us warm, then reads ~10 us), while each native planner follows the others'
-runs on the same map and its own setup in its harness, warmer. ``--flush MB`` (a third reading,
-with ``--warm 0``) writes and reads that many MB of a buffer in the planner's own process (ours
-and the Python bindings' here, native OMPL's in its harness) right before every timed run, so
-that every planner starts from caches evicted alike.
+with a 1 ms budget (``--warm SECONDS``, default 0.001), while trials still alternate between the
+planners. (OMPL's own benchmark tool, ``ompl::tools::Benchmark::benchmark``, also runs one
+planner's runs back to back, planners in the outer loop, though with ``clear()``, path checks
+and simplification between runs rather than a warm-up run.) ``--warm 0`` is the default before
+2026-12-03 (a second reading; it changes the verdict on the maps whose straight segment is
+free): there our first call of a trial follows the Python bindings' runs of the one before,
+with cold caches (a free straight segment's run, one segment test of ~1 us warm, then reads ~10
+us), while each native planner follows the others' runs on the same map and its own setup in
+its harness, warmer. ``--flush MB`` (a third reading, with ``--warm 0``) writes and reads that
+many MB of a buffer in the planner's own process (ours and the Python bindings' here, native
+OMPL's in its harness) after the warm-up run, if any, and right before every timed run, so
+that every planner starts with caches disturbed alike (not emptied: with a last-level cache
+larger than the flush, cold times keep growing with its size; ``bench_cold_call.py``).
 
     python benchmarks/bench_planners.py [--trials 5] [--time-limit 2] [--sets dev,held_out]
         [--warm 0.001] [--flush 0]
@@ -262,10 +265,10 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--warm", type=float, default=0.001, metavar="SECONDS",
                     help="before each timed run, an untimed run of the same planner and query "
                          "with this budget (every planner, ours and OMPL's, starts warm, as each "
-                         "run in OMPL's benchmark tool follows the same planner's; 0: none, the "
-                         "default before 2026-12-03)")  # fmt: skip
+                         "run in OMPL's benchmark tool follows the same planner's; default "
+                         "0.001; 0: none, the default before 2026-12-03)")  # fmt: skip
     flush = "before each timed run (after --warm's), write and read this many MB in the "
-    flush += "planner's process: every planner starts with evicted caches"
+    flush += "planner's process: every planner starts with caches disturbed alike"
     ap.add_argument("--flush", type=float, default=0.0, metavar="MB", help=flush)
     args = ap.parse_args(argv)
     if args.warm < 0 or args.flush < 0:

@@ -71,7 +71,18 @@ def test_a_flush_is_answered_and_leaves_the_next_solve_as_it_was(binary):
             native.flush(flush)
             paths.append(native.solve("BITstar", (2.5, 10.5), (17.5, 10.5), bound=30.0,
                                       limit=1.0).path)  # fmt: skip
-            with pytest.raises(ompl_native.HarnessError, match="flush"):
+            with pytest.raises(ompl_native.HarnessError, match="flush expects BYTES"):
                 native.flush(-1)
+            after = native.solve("BITstar", (2.5, 10.5), (17.5, 10.5), bound=30.0, limit=1.0)
+            assert len(after.path) >= 3  # the harness still answers each command in turn
     assert len(paths[0]) >= 3  # around the wall
     np.testing.assert_array_equal(paths[0], paths[1])
+
+
+def test_a_bad_map_is_refused_and_the_harness_stays_in_step(binary):
+    with ompl_native.Harness(binary) as native:
+        with pytest.raises(ompl_native.HarnessError, match="map expects H W and H\\*W cells"):
+            native.set_map(np.zeros((0, 5), np.uint8))  # no cells
+        native.set_map(np.zeros((10, 10), np.uint8))
+        r = native.solve("BITstar", (1.5, 1.5), (8.5, 8.5), bound=12.0, limit=1.0)
+    assert len(r.path) >= 2

@@ -122,14 +122,20 @@ class Harness:
         g = np.asarray(grid) != 0
         cells = "".join(np.where(g.ravel(), "1", "0"))
         self._proc.stdin.write(f"map {g.shape[0]} {g.shape[1]} {cells}\n")
+        self._answer("mapped", "a map")
 
     def flush(self, nbytes: int) -> None:
         """Write and read ``nbytes`` bytes of a buffer in the harness process (evicting the
         CPU caches its next solve would find warm), and wait for its answer."""
         self._proc.stdin.write(f"flush {int(nbytes)}\n")
+        self._answer("flushed", "a flush")
+
+    def _answer(self, expected: str, what: str) -> None:
+        """Read the harness's one answer line to a command, which must start with
+        ``expected``; raise :class:`HarnessError` quoting it otherwise."""
         answer = self._proc.stdout.readline().strip()
-        if not answer.startswith("flushed"):
-            raise HarnessError(f"the harness answered {answer!r} to a flush")
+        if not answer.startswith(expected):
+            raise HarnessError(f"the harness answered {answer!r} to {what}")
 
     def solve(self, planner: str, start, goal, bound: float, limit: float,
               step: float = 0.0) -> NativeRun:  # fmt: skip

@@ -1,8 +1,10 @@
 // Native OMPL on an occupancy grid: the baseline of benchmarks/bench_planners.py.
 //
-// Reads commands on stdin, one per line, answers each `solve` with one line on stdout:
+// Reads commands on stdin, one per line, and answers each but `quit` with one line on stdout
+// ("error WHY" when it fails):
 //   map H W CELLS          CELLS: H*W characters '0' (free) / '1' (obstacle), row-major
-//                          (index y * W + x), the grid of the following solves
+//                          (index y * W + x), the grid of the following solves; answers
+//                          "mapped H W"
 //   solve PLANNER RANGE SX SY GX GY BOUND LIMIT
 //                          PLANNER: RRTstar InformedRRTstar BITstar ABITstar AITstar;
 //                          RANGE: the Steer step in pixels (0: OMPL's default);
@@ -180,6 +182,7 @@ int main(int argc, char **argv) {
         try {
             if (cmd == "map") {
                 grid = read_map(in);
+                std::cout << "mapped " << grid.h << " " << grid.w << std::endl;
             } else if (cmd == "solve") {
                 std::cout << solve(grid, in) << std::endl;
             } else if (cmd == "flush") {

@@ -1,0 +1,84 @@
+"""Benchmark: what a call costs with cold caches, against the same call warm, where our planner
+does least: the run of a free straight segment, one compiled call (``core.query_test``).
+
+On each of the development maps whose straight segment is free, the median over ``--calls``
+calls of: a Python function of the same six arguments (the baseline), a trivial compiled
+(numba) function of them, and our run's compiled call; each timed cold (right after ``--flush``
+MB of a buffer are written and read, as ``bench_planners.py --flush``) and warm (back to back).
+The ratios are to the Python call measured in the same run. It shows where a cold run's time
+goes: the compiled call's dispatch (argument typing, unboxing) against the segment test.
+
+    python benchmarks/bench_cold_call.py [--calls 60] [--flush 64]
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+import numpy as np
+from numba import njit
+
+from planner_maps import dev_instances
+from vnrrt.planners import core, segment_free, warmup
+
+
+@njit(cache=True)
+def trivial(occ, sx, sy, gx, gy, straight):
+    """A compiled function of the run's arguments that does nothing (its dispatch alone)."""
+    return sx
+
+
+def python(occ, sx, sy, gx, gy, straight):
+    """The same in Python: the baseline."""
+    return sx
+
+
+def median_us(fn, args: tuple, calls: int, flush: np.ndarray | None) -> float:
+    """Median microseconds of ``fn(*args)`` over ``calls`` calls, each after a flush of
+    ``flush`` (every 64-byte line written and read) when given, else back to back."""
+    times = []
+    for _ in range(calls):
+        if flush is not None:
+            flush[::64] += 1
+            int(flush[::64].sum())
+        t0 = time.perf_counter()
+        fn(*args)
+        times.append(time.perf_counter() - t0)
+    return 1e6 * float(np.median(times))
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--calls", type=int, default=60, help="calls per figure and map")
+    ap.add_argument("--flush", type=float, default=64.0, metavar="MB", help="flush size")
+    args = ap.parse_args(argv)
+    warmup()
+    buffer = np.zeros(int(args.flush * 2**20), np.uint8)
+    figures = {"python call": python, "compiled no-op": trivial, "our run": core.query_test}
+    print(f"median us over {args.calls} calls; cold: after a {args.flush:g} MB flush")
+    print(f"{'map':<10}" + "".join(f"{f + ' cold':>20}{'warm':>7}" for f in figures))
+    ratios = {f: [] for f in figures}
+    for name, g, s, e in dev_instances():
+        occ = np.ascontiguousarray(g, np.uint8)
+        xy = (*map(float, s), *map(float, e))
+        if not segment_free(occ, *xy):
+            continue
+        args_ = (occ, *xy, True)
+        row = f"{name:<10}"
+        base = None
+        for label, fn in figures.items():
+            fn(*args_)  # compiled (or loaded) before timing
+            cold = median_us(fn, args_, args.calls, buffer)
+            warm = median_us(fn, args_, 20 * args.calls, None)
+            base = base or cold
+            ratios[label].append(cold / base)
+            row += f"{cold:>20.2f}{warm:>7.2f}"
+        print(row)
+    for label, vals in ratios.items():
+        print(f"{label}: cold / the Python call's cold, median over maps {np.median(vals):.2f}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
