@@ -19,6 +19,7 @@ import time
 import numpy as np
 from numba import njit
 
+from bench_planners import flush_here
 from planner_maps import dev_instances
 from vnrrt.planners import core, segment_free, warmup
 
@@ -34,14 +35,13 @@ def python(occ, sx, sy, gx, gy, straight):
     return sx
 
 
-def median_us(fn, args: tuple, calls: int, flush: np.ndarray | None) -> float:
+def median_us(fn, args: tuple, calls: int, flush: int) -> float:
     """Median microseconds of ``fn(*args)`` over ``calls`` calls, each after a flush of
-    ``flush`` (every 64-byte line written and read) when given, else back to back."""
+    ``flush`` bytes (:func:`bench_planners.flush_here`) when nonzero, else back to back."""
     times = []
     for _ in range(calls):
-        if flush is not None:
-            flush[::64] += 1
-            int(flush[::64].sum())
+        if flush:
+            flush_here(flush)
         t0 = time.perf_counter()
         fn(*args)
         times.append(time.perf_counter() - t0)
@@ -54,7 +54,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--flush", type=float, default=64.0, metavar="MB", help="flush size")
     args = ap.parse_args(argv)
     warmup()
-    buffer = np.zeros(int(args.flush * 2**20), np.uint8)
+    nbytes = int(args.flush * 2**20)
     figures = {"python call": python, "compiled no-op": trivial, "our run": core.query_test}
     print(f"median us over {args.calls} calls; cold: after a {args.flush:g} MB flush")
     print(f"{'map':<10}" + "".join(f"{f + ' cold':>20}{'warm':>7}" for f in figures))
@@ -69,8 +69,8 @@ def main(argv: list[str] | None = None) -> int:
         base = None
         for label, fn in figures.items():
             fn(*args_)  # compiled (or loaded) before timing
-            cold = median_us(fn, args_, args.calls, buffer)
-            warm = median_us(fn, args_, 20 * args.calls, None)
+            cold = median_us(fn, args_, args.calls, nbytes)
+            warm = median_us(fn, args_, 20 * args.calls, 0)
             base = base or cold
             ratios[label].append(cold / base)
             row += f"{cold:>20.2f}{warm:>7.2f}"
