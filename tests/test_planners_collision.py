@@ -127,3 +127,43 @@ def test_a_querys_compiled_checks_match_the_brute_force_reference(grid, lattice)
         assert plain == (core.BAD_ENDPOINT if want == core.BAD_ENDPOINT else -1.0), p
         seen.add("bad" if want == core.BAD_ENDPOINT else "blocked" if want < 0 else "free")
     assert seen == {"bad", "blocked", "free"}
+
+
+@pytest.mark.parametrize("shape", [(7, 40), (40, 7), (23, 31)])
+def test_shallow_steep_and_axis_parallel_segments_match_the_reference(shape):
+    """The column walk's one-or-two-cell step (a shallow segment) and its loop (a steep one)
+    agree with :func:`reference_free` on maps that are not square, for segments of every
+    slope: random, on the half-pixel lattice (edges and corners hit exactly), horizontal and
+    vertical."""
+    rng = np.random.default_rng(sum(shape))
+    h, w = shape
+    grid = (rng.random(shape) < 0.06).astype(np.uint8)
+    hi = [w - 0.2, h - 0.2, w - 0.2, h - 0.2]
+    seen = {True: 0, False: 0}
+    for i in range(1200):
+        p = rng.uniform(0.2, hi)
+        if i % 4 == 1:
+            p = np.clip(np.round(p * 2) / 2, 0.5, np.subtract(hi, 0.3))
+        elif i % 4 == 2:
+            p[3] = p[1]  # horizontal
+        elif i % 4 == 3:
+            p[2] = p[0]  # vertical
+        got = segment_free(grid, *p)
+        assert got == reference_free(grid, p[:2], p[2:]), p
+        seen[got] += 1
+    assert min(seen.values()) > 100
+
+
+def test_coordinates_outside_the_map_or_not_finite_are_never_free():
+    """Off-map, infinite and NaN coordinates give False: a segment to x = 1e300 was reported
+    free before (the column count overflowed an int64 and the walk tested no column)."""
+    g = np.zeros((50, 60), np.uint8)
+    assert segment_free(g, 1.5, 20.0, 58.5, 30.0)
+    bad = [1e300, -1e300, 1e20, np.inf, -np.inf, np.nan, 60.0, -0.5, 0.0]  # 60: x = W, y > H
+    for v in bad:
+        for k in range(4):
+            p = [1.5, 20.0, 58.5, 30.0]
+            p[k] = v
+            assert not segment_free(g, *p), p
+    for v in (np.inf, np.nan):  # a vertical segment with one end not finite
+        assert not segment_free(g, 3.5, 20.0, 3.5, v) and not segment_free(g, 3.5, v, 3.5, 20.0)

@@ -15,7 +15,8 @@ Semantics, chosen to be conservative and stated once here:
 The test walks the segment column by column (a supercover traversal): for each grid
 column the segment crosses, it computes the exact ``y`` extent of the segment inside
 that column and checks every cell of the column in that extent. No touched cell is ever
-skipped, and the work is proportional to the number of touched cells.
+skipped, and the work is proportional to the number of touched cells. Coordinates outside
+the map, infinite or NaN give False.
 """
 
 from __future__ import annotations
@@ -38,28 +39,43 @@ def segment_free(occ: np.ndarray, x0: float, y0: float, x1: float, y1: float) ->
     h, w = occ.shape
     if x0 > x1:  # walk left to right
         x0, y0, x1, y1 = x1, y1, x0, y0
-    dx = x1 - x0
-    slope = (y1 - y0) / dx if dx > 0.0 else 0.0
+    if not (x0 - MARGIN >= 0.0 and x1 + MARGIN < w):  # the border touched (or NaN: False)
+        return False
     c_lo = int(math.floor(x0 - MARGIN))
     c_hi = int(math.floor(x1 + MARGIN))
-    if c_lo < 0 or c_hi >= w:
+    dx = x1 - x0
+    if not dx > 0.0:  # vertical (or a point): each column holds the segment's whole y extent
+        if not (y0 - MARGIN >= 0.0 and y1 - MARGIN >= 0.0 and y0 + MARGIN < h and y1 + MARGIN < h):
+            return False
+        r_lo = int(math.floor(min(y0, y1) - MARGIN))
+        r_hi = int(math.floor(max(y0, y1) + MARGIN))
+        for cx in range(c_lo, c_hi + 1):
+            for cy in range(r_lo, r_hi + 1):
+                if occ[cy, cx]:
+                    return False
+        return True
+    slope = (y1 - y0) / dx
+    ya = y0 + (x0 - x0) * slope  # y at the first column's left end (x0)
+    y_end = y0 + (x1 - x0) * slope  # and at the last one's right end (x1)
+    ok = ya - MARGIN >= 0.0 and y_end - MARGIN >= 0.0 and ya + MARGIN < h and y_end + MARGIN < h
+    if not ok:  # y is monotone in x (so are its rounded values): the ends bound every column
         return False
     for cx in range(c_lo, c_hi + 1):
-        # Part of the segment inside the closed column [cx, cx + 1], clamped to [x0, x1].
-        xa = min(max(x0, float(cx)), x1)
+        # Part of the segment inside the closed column [cx, cx + 1], clamped to [x0, x1]: from
+        # the previous column's right end (ya) to this one's (yb).
         xb = max(min(x1, float(cx + 1)), x0)
-        if dx > 0.0:
-            ya = y0 + (xa - x0) * slope
-            yb = y0 + (xb - x0) * slope
-        else:
-            ya, yb = y0, y1
-        r_lo = int(math.floor(min(ya, yb) - MARGIN))
-        r_hi = int(math.floor(max(ya, yb) + MARGIN))
-        if r_lo < 0 or r_hi >= h:
-            return False
-        for cy in range(r_lo, r_hi + 1):
-            if occ[cy, cx]:
+        yb = y0 + (xb - x0) * slope
+        r_lo = np.uintp(min(ya, yb) - MARGIN)  # >= 0 (checked above): truncation is floor
+        r_hi = np.uintp(max(ya, yb) + MARGIN)  # (unsigned indices: no wraparound test)
+        ya = yb
+        c = np.uintp(cx)
+        if r_hi - r_lo <= 1:  # one or two cells (a shallow segment): tested without a loop
+            if occ[r_lo, c] | occ[r_hi, c]:
                 return False
+        else:
+            for cy in range(r_lo, r_hi + 1):
+                if occ[cy, c]:
+                    return False
     return True
 
 
