@@ -118,34 +118,35 @@ def hopeless(p, x, y, c_best):
     return p.informed and math.hypot(x - p.sx, y - p.sy) + math.hypot(x - p.gx, y - p.gy) > c_best
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def choose_parent(occ, tree, scratch, counters, p, k, x, y, p0, c0, c_best):
     """Extend: cheapest collision-free parent for a new node at ``(x, y)`` among the ``k``
     near nodes, tried in order of cost-through-them; ``p0`` (the nearest node, already
     checked) with cost ``c0`` is the default. Segment checks are cached in
     ``scratch.near_ok`` for :func:`rewire`."""
-    s = scratch
+    idx, dist, through, ok = scratch.near_idx, scratch.near_d, scratch.near_c, scratch.near_ok
+    pts, cost = tree.pts, tree.cost  # (arrays taken out of the tuples once, not per node)
     for j in range(k):
-        q = s.near_idx[j]
-        s.near_c[j] = tree.cost[q] + s.near_d[j]
-        s.near_ok[j] = 1 if q == p0 else 0
-        if q != p0 and hopeless(p, tree.pts[q, 0], tree.pts[q, 1], c_best):
-            s.near_ok[j] = 2  # skipped: no candidate
-    for j in np.argsort(s.near_c[:k]):
-        if s.near_c[j] >= c0:
+        q = idx[j]
+        through[j] = cost[q] + dist[j]
+        ok[j] = 1 if q == p0 else 0
+        if q != p0 and hopeless(p, pts[q, 0], pts[q, 1], c_best):
+            ok[j] = 2  # skipped: no candidate
+    for j in np.argsort(through[:k]):
+        if through[j] >= c0:
             break
-        if s.near_ok[j] == 2:
+        if ok[j] == 2:
             continue
-        q = s.near_idx[j]
+        q = idx[j]
         counters.checks[0] += 1
-        if segment_free(occ, tree.pts[q, 0], tree.pts[q, 1], x, y):
-            s.near_ok[j] = 1
-            return q, s.near_c[j]
-        s.near_ok[j] = 2
+        if segment_free(occ, pts[q, 0], pts[q, 1], x, y):
+            ok[j] = 1
+            return q, through[j]
+        ok[j] = 2
     return p0, c0
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def pull_up(occ, tree, counters, q, c, x, y):
     """Theta*'s any-angle parent (Nash et al. 2007): from the chosen parent ``q`` (cost ``c``
     through it), walk up to its parent while that one sees ``(x, y)``; returns the last
@@ -160,28 +161,27 @@ def pull_up(occ, tree, counters, q, c, x, y):
         q, c = a, tree.cost[a] + math.hypot(x - tree.pts[a, 0], y - tree.pts[a, 1])
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def rewire(occ, tree, scratch, counters, k, new):
     """Rewire: re-parent near nodes through ``new`` when that is cheaper and free (nodes
     skipped by :func:`choose_parent` stay as they are)."""
-    s = scratch
+    idx, dist, known = scratch.near_idx, scratch.near_d, scratch.near_ok
+    pts, cost, links = tree.pts, tree.cost, tree.links  # (taken out of the tuples once)
     for j in range(k):
-        q = s.near_idx[j]
-        c = tree.cost[new] + s.near_d[j]
-        if q == tree.links[new, PARENT] or c >= tree.cost[q] - 1e-9:
+        q = idx[j]
+        c = cost[new] + dist[j]
+        if q == links[new, PARENT] or c >= cost[q] - 1e-9:
             continue
-        ok = s.near_ok[j]
+        ok = known[j]
         if ok == 0:
             counters.checks[0] += 1
-            free = segment_free(
-                occ, tree.pts[q, 0], tree.pts[q, 1], tree.pts[new, 0], tree.pts[new, 1]
-            )
+            free = segment_free(occ, pts[q, 0], pts[q, 1], pts[new, 0], pts[new, 1])
             ok = 1 if free else 2
         if ok == 1:
-            reparent(tree, s.stack, q, new, c)
+            reparent(tree, scratch.stack, q, new, c)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def connect_goal(occ, tree, counters, stack, p, new):
     """Connect (or re-parent) the goal leaf to ``new`` when within ``p.goal_radius``,
     cheaper and free."""
@@ -236,7 +236,7 @@ def plant(occ, tree, counters, stack, trace, p, milestones):
     record(counters, tree, trace, milestones)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def near_radius(n, p):
     """Near radius for a tree of ``n`` nodes: ``min(gamma sqrt(log n / n), eta)``, or the
     fixed ``radius`` when ``gamma <= 0``."""
@@ -246,7 +246,7 @@ def near_radius(n, p):
     return min(p.gamma * math.sqrt(math.log(n) / n), p.eta)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def sample(rng, h, w, draws, p, c_best):
     """Sample: the sampler's (or the gap sampler's) draw, inside the informed ellipse once
     a solution exists (:func:`vnrrt.planners.samplers.any_point`)."""
@@ -265,9 +265,10 @@ def grow(occ, tree, scratch, counters, trace, rng, draws, milestones, p, n_iter)
     the sampler state.
     """
     h, w = occ.shape
+    pts = tree.pts  # (taken out of the tuple once, not at every use)
     for _ in range(n_iter):
         new = counters.nodes[0]
-        if new + (1 if counters.goal[0] >= 0 else 2) > tree.pts.shape[0]:
+        if new + (1 if counters.goal[0] >= 0 else 2) > pts.shape[0]:
             return TREE_FULL
         counters.iters[0] += 1
         c_best = best_cost(tree, counters)
@@ -279,14 +280,14 @@ def grow(occ, tree, scratch, counters, trace, rng, draws, milestones, p, n_iter)
                 continue
         sx, sy = sample(rng, h, w, draws, p, c_best)
         near = spatial.nearest(tree.head, tree.bnext, tree.pts, p.bucket, sx, sy)
-        d = math.hypot(sx - tree.pts[near, 0], sy - tree.pts[near, 1])
+        d = math.hypot(sx - pts[near, 0], sy - pts[near, 1])
         if d <= p.min_spacing:  # a node here would duplicate its nearest node
             continue
         t = min(1.0, p.eta / d)  # Steer
-        x = tree.pts[near, 0] + t * (sx - tree.pts[near, 0])
-        y = tree.pts[near, 1] + t * (sy - tree.pts[near, 1])
+        x = pts[near, 0] + t * (sx - pts[near, 0])
+        y = pts[near, 1] + t * (sy - pts[near, 1])
         counters.checks[0] += 1
-        if not segment_free(occ, tree.pts[near, 0], tree.pts[near, 1], x, y):
+        if not segment_free(occ, pts[near, 0], pts[near, 1], x, y):
             continue
         r = near_radius(new + 1, p)
         k = spatial.near(

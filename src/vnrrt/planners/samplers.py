@@ -166,7 +166,7 @@ def _heat_point(s, w, cdf, last):
     return _below(px + next_double(s), px + 1.0), _below(py + next_double(s), py + 1.0)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def sample_point(s, h, w, mix, cdf, last):
     """One sample ``(x, y)`` in pixels (see module doc); ``s`` is the rng state."""
     if mix > 0.0 and next_double(s) < mix:
@@ -222,7 +222,7 @@ def ellipse_uniform(s, h, w, sx, sy, gx, gy, c_best):
     return sx + t * (gx - sx), sy + t * (gy - sy)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def informed_point(s, h, w, mix, cdf, last, sx, sy, gx, gy, c_best):
     """One informed sample: with probability ``mix`` a heatmap draw conditioned on the ellipse
     (rejection, at most :data:`HEATMAP_TRIES` draws; when all fall outside, the heatmap has
@@ -245,7 +245,7 @@ def _cell_point(s, w, cells, n):
     return _below(px + next_double(s), px + 1.0), _below(py + next_double(s), py + 1.0)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def gap_point(s, h, w, cells, n, informed, sx, sy, gx, gy, c_best):
     """One draw of the gap sampler: a uniform point of a cell drawn uniformly from the ``n``
     gap cells (flat indices ``cells``, :mod:`.gaps`); when ``informed``, conditioned on the
@@ -260,7 +260,7 @@ def gap_point(s, h, w, cells, n, informed, sx, sy, gx, gy, c_best):
     return ellipse_uniform(s, h, w, sx, sy, gx, gy, c_best)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def any_point(s, h, w, mix, cdf, last, share, cells, n, informed, sx, sy, gx, gy, c_best):
     """One sample of a planner: with probability ``share`` (when ``n`` gap cells exist) a
     :func:`gap_point`, else the sampler's draw (:func:`informed_point` when ``informed``,

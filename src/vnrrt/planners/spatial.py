@@ -25,7 +25,7 @@ def _bucket_of(v, bucket, n):
     return min(max(int(v / bucket), 0), n - 1)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def insert(head, nxt, bucket, i, x, y):
     """Add node ``i`` at ``(x, y)`` to the bucket grid."""
     by = _bucket_of(y, bucket, head.shape[0])
@@ -34,7 +34,7 @@ def insert(head, nxt, bucket, i, x, y):
     head[by, bx] = i
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _scan(head, nxt, pts, by, bx, x, y, best, best_d2):
     i = head[by, bx]
     while i >= 0:
@@ -45,7 +45,7 @@ def _scan(head, nxt, pts, by, bx, x, y, best, best_d2):
     return best, best_d2
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def nearest(head, nxt, pts, bucket, x, y):
     """Index of the node nearest to ``(x, y)`` (Euclidean), or -1 if the grid is empty.
 
@@ -67,7 +67,7 @@ def nearest(head, nxt, pts, bucket, x, y):
     return best
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def near(head, nxt, pts, bucket, x, y, r, out_idx, out_d):
     """Nodes within distance ``r`` of ``(x, y)``: fills ``out_idx``/``out_d``, returns count."""
     nby, nbx = head.shape

@@ -118,7 +118,7 @@ def _link(links, i, parent):
         links[parent, CHILD] = i
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def add_node(tree, i, parent, x, y, c):
     """Write node ``i`` at ``(x, y)`` with cost ``c`` as a new leaf under ``parent``."""
     tree.pts[i, 0], tree.pts[i, 1], tree.cost[i] = x, y, c
@@ -126,7 +126,7 @@ def add_node(tree, i, parent, x, y, c):
     _link(tree.links, i, parent)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def reparent(tree, stack, i, parent, c):
     """Move node ``i`` under ``parent`` with new cost ``c``; shift its subtree's costs."""
     links, cost = tree.links, tree.cost
@@ -159,7 +159,7 @@ def best_cost(tree, counters):
     return tree.cost[g] if g >= 0 else np.inf
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def record(counters, tree, trace, milestones):
     """Append to the sparse trace; return True when the best cost passed a milestone.
 
