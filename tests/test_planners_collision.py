@@ -167,3 +167,64 @@ def test_coordinates_outside_the_map_or_not_finite_are_never_free():
             assert not segment_free(g, *p), p
     for v in (np.inf, np.nan):  # a vertical segment with one end not finite
         assert not segment_free(g, 3.5, 20.0, 3.5, v) and not segment_free(g, 3.5, v, 3.5, 20.0)
+
+
+def column_walk(grid, x0, y0, x1, y1) -> bool:
+    """The column walk written plainly (plain Python floats, the same operations in the
+    same order as the module docstring's rule): every column's clamped x extent, its y
+    extent, the rows in it widened by the margin, every cell tested."""
+    from vnrrt.planners.collision import MARGIN
+
+    h, w = grid.shape
+    if x0 > x1:
+        x0, y0, x1, y1 = x1, y1, x0, y0
+    if not all(np.isfinite((x0, y0, x1, y1))):
+        return False
+    dx = x1 - x0
+    slope = (y1 - y0) / dx if dx > 0.0 else 0.0
+    c_lo, c_hi = int(np.floor(x0 - MARGIN)), int(np.floor(x1 + MARGIN))
+    if c_lo < 0 or c_hi >= w:
+        return False
+    for cx in range(c_lo, c_hi + 1):
+        xa, xb = min(max(x0, float(cx)), x1), max(min(x1, float(cx + 1)), x0)
+        ya, yb = (y0 + (xa - x0) * slope, y0 + (xb - x0) * slope) if dx > 0.0 else (y0, y1)
+        r_lo, r_hi = int(np.floor(min(ya, yb) - MARGIN)), int(np.floor(max(ya, yb) + MARGIN))
+        if r_lo < 0 or r_hi >= h or grid[r_lo : r_hi + 1, cx].any():
+            return False
+    return True
+
+
+@pytest.mark.parametrize("shape", [(9, 30), (30, 9), (17, 17)])
+def test_segments_within_the_margin_of_edges_match_the_plain_column_walk(shape):
+    """At the rounding margin's scale (endpoints on integer and half-pixel coordinates, then
+    moved by 0, +-0.5, +-1 or +-2 margins), where the exact reference's closed squares and
+    the margin differ by design, the compiled walk answers as :func:`column_walk` does."""
+    rng = np.random.default_rng(sum(shape) + 1)
+    h, w = shape
+    grid = (rng.random(shape) < 0.1).astype(np.uint8)
+    offsets = np.array([0.0, 5e-10, -5e-10, 1e-9, -1e-9, 2e-9, -2e-9])
+    seen = {True: 0, False: 0}
+    for i in range(3000):
+        p = np.round(rng.uniform(0.0, [w, h, w, h]) * (1 + i % 2)) / (1 + i % 2)
+        p = p + rng.choice(offsets, 4)
+        if i % 5 == 3:
+            p[2] = p[0]  # vertical
+        elif i % 5 == 4:
+            p[3] = p[1]  # horizontal
+        got = segment_free(grid, *p)
+        assert got == column_walk(grid, *(float(v) for v in p)), p
+        seen[got] += 1
+    assert min(seen.values()) > 200
+
+
+@pytest.mark.parametrize("dtype", [np.bool_, np.int64, np.float32, np.float64])
+def test_any_grid_dtype_gives_the_uint8_answers(grid, dtype):
+    """A grid of another dtype (nonzero = obstacle) answers as the uint8 one does."""
+    rng = np.random.default_rng(5)
+    h, w = grid.shape
+    other = grid.astype(dtype)
+    for _ in range(300):
+        p = rng.uniform(0.2, [w - 0.2, h - 0.2, w - 0.2, h - 0.2])
+        assert segment_free(other, *p) == segment_free(grid, *p), p
+    path = rng.uniform(0.2, [w - 0.2, h - 0.2], (6, 2))
+    assert path_free(other, path) == path_free(grid, path)

@@ -33,8 +33,9 @@ MARGIN = 1e-9  # pixels
 def segment_free(occ: np.ndarray, x0: float, y0: float, x1: float, y1: float) -> bool:
     """True when segment ``(x0, y0)-(x1, y1)`` (pixels) touches no obstacle cell.
 
-    ``occ`` is an ``(H, W)`` uint8 occupancy grid (nonzero = obstacle), indexed
-    ``occ[y, x]``. See the module docstring for the exact (closed, conservative) rule.
+    ``occ`` is an ``(H, W)`` occupancy grid (nonzero = obstacle; uint8 as the planners pass
+    it, any numeric or bool dtype works), indexed ``occ[y, x]``. See the module docstring
+    for the exact (closed, conservative) rule.
     """
     h, w = occ.shape
     if x0 > x1:  # walk left to right
@@ -55,7 +56,7 @@ def segment_free(occ: np.ndarray, x0: float, y0: float, x1: float, y1: float) ->
                     return False
         return True
     slope = (y1 - y0) / dx
-    ya = y0 + (x0 - x0) * slope  # y at the first column's left end (x0)
+    ya = y0  # y at the first column's left end (x0)
     y_end = y0 + (x1 - x0) * slope  # and at the last one's right end (x1)
     ok = ya - MARGIN >= 0.0 and y_end - MARGIN >= 0.0 and ya + MARGIN < h and y_end + MARGIN < h
     if not ok:  # y is monotone in x (so are its rounded values): the ends bound every column
@@ -65,12 +66,12 @@ def segment_free(occ: np.ndarray, x0: float, y0: float, x1: float, y1: float) ->
         # the previous column's right end (ya) to this one's (yb).
         xb = max(min(x1, float(cx + 1)), x0)
         yb = y0 + (xb - x0) * slope
-        r_lo = np.uintp(min(ya, yb) - MARGIN)  # >= 0 (checked above): truncation is floor
-        r_hi = np.uintp(max(ya, yb) + MARGIN)  # (unsigned indices: no wraparound test)
+        r_lo = np.uintp(min(ya, yb) - MARGIN)  # >= 0 (checked above): truncation is floor;
+        r_hi = np.uintp(max(ya, yb) + MARGIN)  # unsigned: the two-cell step's indexing has
         ya = yb
-        c = np.uintp(cx)
+        c = np.uintp(cx)  # no wraparound test
         if r_hi - r_lo <= 1:  # one or two cells (a shallow segment): tested without a loop
-            if occ[r_lo, c] | occ[r_hi, c]:
+            if (occ[r_lo, c] != 0) | (occ[r_hi, c] != 0):  # any dtype (uint8, bool, float)
                 return False
         else:
             for cy in range(r_lo, r_hi + 1):

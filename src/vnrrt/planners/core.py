@@ -279,7 +279,7 @@ def grow(occ, tree, scratch, counters, trace, rng, draws, milestones, p, n_iter)
             if moved != AT_REST:
                 continue
         sx, sy = sample(rng, h, w, draws, p, c_best)
-        near = spatial.nearest(tree.head, tree.bnext, tree.pts, p.bucket, sx, sy)
+        near = spatial.nearest(tree.head, tree.bnext, pts, p.bucket, sx, sy)
         d = math.hypot(sx - pts[near, 0], sy - pts[near, 1])
         if d <= p.min_spacing:  # a node here would duplicate its nearest node
             continue
@@ -291,7 +291,7 @@ def grow(occ, tree, scratch, counters, trace, rng, draws, milestones, p, n_iter)
             continue
         r = near_radius(new + 1, p)
         k = spatial.near(
-            tree.head, tree.bnext, tree.pts, p.bucket, x, y, r, scratch.near_idx, scratch.near_d
+            tree.head, tree.bnext, pts, p.bucket, x, y, r, scratch.near_idx, scratch.near_d
         )
         q, c = choose_parent(
             occ, tree, scratch, counters, p, k, x, y, near, tree.cost[near] + t * d, c_best
