@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from vnrrt.planners import core, path_free, point_free, segment_free
+from vnrrt.planners.collision import MARGIN
 
 
 def touches_box(p0, p1, lo, hi) -> bool:
@@ -173,8 +174,6 @@ def column_walk(grid, x0, y0, x1, y1) -> bool:
     """The column walk written plainly (plain Python floats, the same operations in the
     same order as the module docstring's rule): every column's clamped x extent, its y
     extent, the rows in it widened by the margin, every cell tested."""
-    from vnrrt.planners.collision import MARGIN
-
     h, w = grid.shape
     if x0 > x1:
         x0, y0, x1, y1 = x1, y1, x0, y0

@@ -66,10 +66,12 @@ def segment_free(occ: np.ndarray, x0: float, y0: float, x1: float, y1: float) ->
         # the previous column's right end (ya) to this one's (yb).
         xb = max(min(x1, float(cx + 1)), x0)
         yb = y0 + (xb - x0) * slope
-        r_lo = np.uintp(min(ya, yb) - MARGIN)  # >= 0 (checked above): truncation is floor;
-        r_hi = np.uintp(max(ya, yb) + MARGIN)  # unsigned: the two-cell step's indexing has
+        # Rows and column as unsigned ints: >= 0 (checked above), so truncation is floor, and
+        # the two-cell step's indexing needs no wraparound test.
+        r_lo = np.uintp(min(ya, yb) - MARGIN)
+        r_hi = np.uintp(max(ya, yb) + MARGIN)
         ya = yb
-        c = np.uintp(cx)  # no wraparound test
+        c = np.uintp(cx)
         if r_hi - r_lo <= 1:  # one or two cells (a shallow segment): tested without a loop
             if (occ[r_lo, c] != 0) | (occ[r_hi, c] != 0):  # any dtype (uint8, bool, float)
                 return False
