@@ -3,6 +3,7 @@
 import functools
 import itertools
 import math
+import types
 
 import numpy as np
 import pytest
@@ -318,6 +319,20 @@ def same_run(a, b) -> bool:
     return reached == [(m.bound, m.iteration) for m in b.milestones]
 
 
+@pytest.fixture(params=["c", "python"])
+def answers(request, monkeypatch) -> types.SimpleNamespace:
+    """The free straight segment's answer function in use (``kind``: the C one of
+    :mod:`vnrrt.planners.native`, or :func:`run.free_answer`), wrapped to record its
+    ``calls``; the C one must be built here (a compiler is part of the setup)."""
+    from vnrrt.planners import api, native
+
+    real = native.answerer() if request.param == "c" else run.free_answer
+    assert (real is not run.free_answer) is (request.param == "c"), "the C answer is not built"
+    seen = types.SimpleNamespace(kind=request.param, calls=[])
+    monkeypatch.setattr(api, "answerer", lambda: lambda *a: seen.calls.append(a) or real(*a))
+    return seen
+
+
 @pytest.mark.parametrize(
     ("stop", "reference", "seed", "extra", "fast"),
     [
@@ -337,12 +352,12 @@ def same_run(a, b) -> bool:
     ],
 )
 def test_a_free_segments_one_pass_answer_is_the_general_paths(
-    grid, heat, monkeypatch, stop, reference, seed, extra, fast
+    grid, heat, monkeypatch, answers, stop, reference, seed, extra, fast
 ):
     """The one-pass answer to a free straight segment of plan() and of Planner.solve
-    (:func:`api._free_segment`) is the general path's (the query checked, then the run)
-    field by field, times apart; it is taken for the common form of the arguments only (the
-    general path is not entered then)."""
+    (:func:`api._free_segment`, with the C answer and the Python one) is the general path's
+    (the query checked, then the run) field by field, times apart; it is taken for the common
+    form of the arguments only (the general path is not entered then)."""
     from vnrrt.planners import api
 
     cfg = PlannerConfig(straight_first=True)
@@ -364,19 +379,21 @@ def test_a_free_segments_one_pass_answer_is_the_general_paths(
         monkeypatch.setattr(
             api, "_query", lambda *a, n=entered, q=real, **k: n.append(1) or q(*a, **k)
         )
-        answers = [p.solve(s, e, **ask)]
+        answers.calls.clear()
+        results = [p.solve(s, e, **ask)]
         if planner == "rrt_star":
-            answers.append(plan(grid, s, e, config=cfg, **ask))
+            results.append(plan(grid, s, e, config=cfg, **ask))
         monkeypatch.setattr(api, "_query", real)
-        assert len(entered) == (0 if fast else len(answers))
-        for r in answers:
+        assert len(entered) == (0 if fast else len(results))
+        assert len(answers.calls) == len(results) or not fast  # the answer function's
+        for r in results:
             assert same_run(r, general) and type(r.cost) is type(general.cost)
             assert [m.bound for m in r.milestones] == [m.bound for m in general.milestones]
             assert r.fallback_uniform is general.fallback_uniform is (planner == "vnrrt_star")
             if fast:  # the straight answer: the one segment test timed
                 assert (r.iterations, r.tree_size) == (0, 2)
                 assert 0 < r.time_to_first == r.time_to_stop
-        assert answers[0].setup_time == p.setup_time  # plan()'s RRT*: 0, no sampler built
+        assert results[0].setup_time == p.setup_time  # plan()'s RRT*: 0, no sampler built
 
 
 @pytest.mark.parametrize(
@@ -515,10 +532,10 @@ def test_the_planners_results_hold_every_field_and_no_other(grid, heat):
                 assert r.__dict__.keys() == FIELDS
 
 
-def test_a_blocked_straight_segment_is_tested_once(grid, monkeypatch):
-    """A query whose straight segment is blocked goes from the one-pass check to the search
-    with the segment tested once (the general path reuses that test), by plan() and
-    Planner.solve alike, with the same result as before."""
+def test_a_blocked_straight_segment_is_tested_once(grid, monkeypatch, answers):
+    """A query whose straight segment is blocked goes from the one-pass check (the C answer or
+    the Python one) to the search with the segment tested once (the general path reuses that
+    test), by plan() and Planner.solve alike, with the same result as before."""
     cfg = PlannerConfig(straight_first=True)
     before = plan(grid, START, GOAL, config=cfg, stop="optimal", reference_length=200.0)
     calls, real = [], run.straight_test
@@ -526,8 +543,10 @@ def test_a_blocked_straight_segment_is_tested_once(grid, monkeypatch):
     p = Planner(grid, config=cfg)
     for solve in (functools.partial(plan, grid, config=cfg), p.solve):
         calls.clear()
+        answers.calls.clear()
         r = solve(START, GOAL, stop="optimal", reference_length=200.0)
-        assert len(calls) == 1 and r.iterations > 0 and same_run(r, before)
+        assert len(answers.calls) == 1 and r.iterations > 0 and same_run(r, before)
+        assert len(calls) == (answers.kind == "python")  # the C answer tests it in C
 
 
 SEEDS = (0, 7, -1, (), (1, 2), (1, -2), (0, 2**70), (True, 1), (np.int64(3), 1), [1, 2],

@@ -28,6 +28,7 @@ from vnrrt.grid import GridError, as_occupancy, as_point
 from vnrrt.planners import core, run
 from vnrrt.planners.collision import segment_free
 from vnrrt.planners.config import PLANNERS, PlannerConfig
+from vnrrt.planners.native import answerer
 from vnrrt.planners.reference import reference_length as compute_reference
 from vnrrt.planners.result import PlanResult
 from vnrrt.planners.samplers import Sampler, heatmap_sampler, rng_state, uniform_sampler
@@ -184,13 +185,12 @@ def _free_segment(
         return None, None
     sx, sy, gx, gy = xy
     warmup()  # before the timed test: its kernel loaded
-    tested = run.straight_test(occ, sx, sy, gx, gy, True)
-    d, found = tested
-    if d < 0 or (target is not None and d > target):  # blocked or above the bound: a tree;
-        bad = d == core.BAD_ENDPOINT  # an endpoint touching an obstacle: _query names it
-        return None, None if bad else ((sx, sy), (gx, gy), tested)
-    return run.straight_result(planner, d, found, (sx, sy), (gx, gy), target, (), False,
-                               reference_length, setup_time, fallback), None  # fmt: skip
+    answer = answerer()(occ, sx, sy, gx, gy, target, planner, reference_length, setup_time,
+                        fallback)  # fmt: skip
+    if type(answer) is tuple:  # blocked or above the bound: a tree; an endpoint touching
+        bad = answer[0] == core.BAD_ENDPOINT  # an obstacle: _query names it
+        return None, None if bad else ((sx, sy), (gx, gy), answer)
+    return answer, None
 
 
 def _seed_ok(seed) -> bool:

@@ -185,6 +185,30 @@ def straight_answer(planner: str, query: Query, tested: tuple[float, float]) -> 
     return None
 
 
+def free_answer(
+    occ: np.ndarray,
+    sx: float,
+    sy: float,
+    gx: float,
+    gy: float,
+    target: float | None,
+    planner: str,
+    reference_length: float | None,
+    setup_time: float,
+    fallback_uniform: bool,
+) -> PlanResult | tuple[float, float]:
+    """The answer of a query whose straight segment is tested first: :func:`straight_result`
+    when the segment from ``(sx, sy)`` to ``(gx, gy)`` is free and meets ``target`` (None: any
+    length), else :func:`straight_test`'s ``(d, seconds)``. The Python version of
+    :mod:`vnrrt.planners.native`'s C one."""
+    tested = straight_test(occ, sx, sy, gx, gy, True)
+    d, found = tested
+    if d < 0 or (target is not None and d > target):
+        return tested
+    return straight_result(planner, d, found, (sx, sy), (gx, gy), target, (), False,
+                           reference_length, setup_time, fallback_uniform)  # fmt: skip
+
+
 def straight_result(
     planner: str,
     d: float,

@@ -1,0 +1,151 @@
+"""The C answer to a free straight segment (vnrrt.planners._straight, bound by
+vnrrt.planners.native) against its Python version, run.free_answer."""
+
+import gc
+import math
+import pickle
+import subprocess
+import sys
+import weakref
+
+import numpy as np
+import pytest
+
+from vnrrt.planners import native, run
+from vnrrt.planners.result import FIELDS, PlanResult
+
+TIMES = ("time_to_first", "time_to_stop")
+
+
+@pytest.fixture(scope="module")
+def c_answer():
+    answer = native.answerer()
+    assert answer is not run.free_answer, "the C answer is not built (make setup compiles it)"
+    return answer
+
+
+def random_map(rng, h: int, w: int, density: float) -> np.ndarray:
+    """An ``(h, w)`` uint8 map of random rectangles covering about ``density`` of it."""
+    occ = np.zeros((h, w), np.uint8)
+    while occ.mean() < density:
+        y, x = rng.integers(0, h), rng.integers(0, w)
+        occ[y : y + rng.integers(1, 6), x : x + rng.integers(1, 6)] = 1
+    return occ
+
+
+def queries(rng, occ: np.ndarray, n: int):
+    """``n`` argument tuples for an answer function: points anywhere on and around the map
+    (some in obstacles, on the border, off the map, not finite), targets None or around the
+    distance."""
+    h, w = occ.shape
+    odd = (math.nan, math.inf, -math.inf, 0.0, float(w), -3.5, 1e300)
+    for k in range(n):
+        xy = [rng.uniform(-1.0, w + 1.0), rng.uniform(-1.0, h + 1.0),
+              rng.uniform(-1.0, w + 1.0), rng.uniform(-1.0, h + 1.0)]  # fmt: skip
+        if k % 4 == 0:
+            xy = [float(np.floor(v)) + 0.5 for v in xy]  # cell centres
+        if k % 23 == 0:
+            xy[k % 4] = odd[k % len(odd)]
+        d = math.hypot(xy[2] - xy[0], xy[3] - xy[1])
+        target = (None, d * 1.01, d * 0.99, d)[k % 4] if math.isfinite(d) else None
+        yield (occ, *xy, target, "rrt_star", (None, 7, 3.5)[k % 3], float(k % 5), k % 2 == 1)
+
+
+def assert_same_answer(a, b) -> None:
+    """The same answer: ``(d, seconds)`` tuples with the same ``d``, or results equal field by
+    field (times apart), with arrays of the same dtype, shape and values and scalars of the
+    same type."""
+    assert type(a) is type(b)
+    if type(a) is tuple:
+        assert a[0] == b[0] and a[1] >= 0 and b[1] >= 0
+        return
+    assert a.__dict__.keys() == b.__dict__.keys() == FIELDS
+    for name in FIELDS - set(TIMES):
+        x, y = getattr(a, name), getattr(b, name)
+        assert type(x) is type(y), name
+        if isinstance(x, np.ndarray):
+            assert (x.dtype, x.shape, x.flags.writeable) == (y.dtype, y.shape, y.flags.writeable)
+            np.testing.assert_array_equal(x, y, err_msg=name)
+        else:
+            assert x == y, name
+    assert 0 < a.time_to_first == a.time_to_stop < 1.0
+
+
+@pytest.mark.parametrize(("h", "w", "density"), [(40, 60, 0.1), (7, 90, 0.05), (90, 7, 0.2),
+                                                 (2, 2, 0.0), (64, 64, 0.0)])  # fmt: skip
+def test_the_c_answer_is_the_python_one(c_answer, h, w, density):
+    """On random maps and queries (free, blocked, above or below the bound, bad endpoints,
+    points off the map or not finite), the C answer is the Python one, times apart."""
+    rng = np.random.default_rng(h * 1000 + w)
+    occ = random_map(rng, h, w, density)
+    kinds = set()
+    for args in queries(rng, occ, 400):
+        a, b = c_answer(*args), run.free_answer(*args)
+        assert_same_answer(a, b)
+        kinds.add("result" if type(a) is PlanResult else a[0] if a[0] < 0 else "over")
+    assert {"result", "over", -2.0} <= kinds  # answers, segments above the bound, bad points
+    assert (-1.0 in kinds) is (density > 0)  # blocked segments
+
+
+def test_the_c_results_own_their_arrays_and_are_freed(c_answer):
+    """Each result has arrays of its own, pickles and unpickles to the same answer, and is
+    freed when dropped; repeated calls leave the reference counts of their arguments and of
+    the shared fields as they were."""
+    occ = np.zeros((30, 30), np.uint8)
+    planner, reference, setup = "rrt_star", 12.5, 0.25
+    args = (occ, 3.5, 4.5, 20.5, 9.5, None, planner, reference, setup, False)
+    a, b = c_answer(*args), c_answer(*args)
+    a.path[0, 0] = a.trace_costs[0] = -1.0
+    a.trace_iterations[0] = 9
+    assert b.path[0, 0] == 3.5 and b.trace_costs[0] == b.cost and b.trace_iterations[0] == 0
+    assert_same_answer(pickle.loads(pickle.dumps(b)), b)
+    dead = weakref.ref(a)
+    del a
+    gc.collect()
+    assert dead() is None
+    counts = [sys.getrefcount(x) for x in (planner, reference, setup, run.STRAIGHT, occ)]
+    for _ in range(2000):
+        c_answer(*args)
+        c_answer(occ, 3.5, 4.5, 35.0, 9.5, None, planner, reference, setup, False)  # off-map
+    assert [sys.getrefcount(x) for x in (planner, reference, setup, run.STRAIGHT, occ)] == counts
+
+
+@pytest.mark.parametrize(
+    ("args", "match"),
+    [
+        ((np.zeros((9, 9)),), "uint8"),  # float64
+        ((np.zeros((9, 9), np.uint8).T[:, ::2],), "C-contiguous"),
+        ((np.zeros(81, np.uint8),), "2-D"),
+        (([[0, 0], [0, 0]],), "ndarray"),
+        ((np.zeros((9, 9), np.uint8), "a"), "real number"),
+    ],
+)
+def test_the_c_answer_refuses_what_it_cannot_read(c_answer, args, match):
+    """A grid that is not a C-contiguous 2-D uint8 ndarray, a point that is not a number or a
+    wrong argument count raise TypeError (the planners pass only checked arguments)."""
+    full = (*args, *(1.5, 1.5, 4.5, 4.5, None, "rrt_star", None, 0.0, False)[len(args) - 1 :])
+    with pytest.raises(TypeError, match=match):
+        c_answer(*full)
+    with pytest.raises(TypeError, match="10 arguments"):
+        c_answer(*full[:9])
+
+
+def test_an_unbound_c_answer_raises_and_a_zero_address_is_refused():
+    """Before bind() the C answer raises instead of calling nothing; bind() refuses a zero
+    kernel address (in a fresh process: this one's module is bound)."""
+    code = (
+        "import numpy as np\n"
+        "from vnrrt.planners import _straight as s\n"
+        "occ = np.zeros((4, 4), np.uint8)\n"
+        "for call in (lambda: s.answer(occ, 1.5, 1.5, 2.5, 2.5, None, 'p', None, 0.0, False),\n"
+        "             lambda: s.bind(0, type, {})):\n"
+        "    try:\n"
+        "        call()\n"
+        "    except (RuntimeError, ValueError) as e:\n"
+        "        print(type(e).__name__, e)\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.splitlines() == [
+        "RuntimeError answer: no kernel bound (call bind first)",
+        "ValueError bind: the kernel address is 0",
+    ]
