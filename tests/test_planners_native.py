@@ -2,10 +2,12 @@
 vnrrt.planners.native) against its Python version, run.free_answer."""
 
 import gc
+import logging
 import math
 import pickle
 import subprocess
 import sys
+import time
 import weakref
 
 import numpy as np
@@ -104,10 +106,55 @@ def test_the_c_results_own_their_arrays_and_are_freed(c_answer):
     gc.collect()
     assert dead() is None
     counts = [sys.getrefcount(x) for x in (planner, reference, setup, run.STRAIGHT, occ)]
-    for _ in range(2000):
+    blocks = sys.getallocatedblocks()
+    for _ in range(5000):
         c_answer(*args)
         c_answer(occ, 3.5, 4.5, 35.0, 9.5, None, planner, reference, setup, False)  # off-map
+    assert sys.getallocatedblocks() - blocks < 100  # no object of a result left behind
     assert [sys.getrefcount(x) for x in (planner, reference, setup, run.STRAIGHT, occ)] == counts
+
+
+def test_the_c_answer_times_its_test_on_perf_counters_clock(c_answer):
+    """The C answer's time lies inside the perf_counter interval around its call, on a long
+    segment test (a 4000 px map: a few us) and a short one."""
+    occ = np.zeros((8, 4000), np.uint8)
+    for gx in (3999.5, 2.5):
+        t0 = time.perf_counter()
+        r = c_answer(occ, 0.5, 0.5, gx, 7.5, None, "rrt_star", None, 0.0, False)
+        span = time.perf_counter() - t0
+        assert 0 < r.time_to_stop == r.time_to_first < span
+
+
+def test_the_python_answer_is_used_where_the_c_one_is_missing_or_cannot_be_bound(
+    monkeypatch, caplog
+):
+    """Without the extension, or when its kernel cannot be compiled or bound, the answer
+    function is the Python one (said in the log), and plan() answers as before."""
+    from vnrrt.planners import FASTEST, plan
+
+    occ = np.zeros((20, 20), np.uint8)
+    want = plan(occ, (1.5, 1.5), (17.5, 12.5), config=FASTEST)
+    import vnrrt.planners
+
+    monkeypatch.setitem(sys.modules, "vnrrt.planners._straight", None)  # not built
+    monkeypatch.delattr(vnrrt.planners, "_straight", raising=False)
+    with caplog.at_level(logging.INFO, logger="vnrrt.planners.native"):
+        assert native.answerer.__wrapped__() is run.free_answer
+    assert "not built" in caplog.text
+    monkeypatch.undo()
+
+    def broken(*args, **kwargs):
+        raise RuntimeError("no compiler today")
+
+    monkeypatch.setattr(native, "cfunc", broken)
+    with caplog.at_level(logging.WARNING, logger="vnrrt.planners.native"):
+        assert native.answerer.__wrapped__() is run.free_answer
+    assert "could not be bound" in caplog.text and "no compiler today" in caplog.text
+    from vnrrt.planners import api
+
+    monkeypatch.setattr(api, "answerer", lambda: run.free_answer)
+    got = plan(occ, (1.5, 1.5), (17.5, 12.5), config=FASTEST)
+    assert (got.cost, got.iterations, got.path.tolist()) == (want.cost, 0, want.path.tolist())
 
 
 @pytest.mark.parametrize(

@@ -4,12 +4,14 @@
  *
  * answer(occ, sx, sy, gx, gy, target, planner, reference_length, setup_time, fallback)
  *   occ: (H, W) C-contiguous uint8 numpy array (nonzero = obstacle, occ[y, x]); sx .. gy:
- *   floats, pixels; target: float or None (the stop bound); the last four go into the result.
- *   Calls the bound kernel (vnrrt.planners.core.query_test compiled by numba as a C function)
- *   and times it with CLOCK_MONOTONIC (the clock of Python's time.perf_counter on Linux).
+ *   numbers, pixels (converted to double; the planners pass floats); target: a number or None
+ *   (the stop bound); the last four go into the result as they are. Calls the bound kernel
+ *   (vnrrt.planners.core.query_test_at, compiled by numba as a C function) and times it on
+ *   the clock of time.perf_counter (CPython's own function, so on every platform).
  *   Returns the PlanResult of the straight answer when the segment is free and its length d
  *   meets target (None: any), else the tuple (d, seconds) as run.straight_test returns it
- *   (d = -1: blocked; -2: an endpoint touches an obstacle or the border).
+ *   (d = -1: blocked; -2: an endpoint touches an obstacle or the border). The seconds are the
+ *   kernel call's; run.straight_test's also hold numba's dispatch (~0.5 us).
  *
  * bind(kernel_address, result_type, fields)
  *   kernel_address: a numba cfunc's address, double f(const uint8 *, intp h, intp w, double
@@ -20,7 +22,6 @@
 #include <Python.h>
 #include <stdint.h>
 #include <string.h>
-#include <time.h>
 #define NPY_NO_DEPRECATED_API NPY_1_7_API_VERSION
 #include <numpy/arrayobject.h>
 
@@ -39,13 +40,19 @@ static const char *key_names[NKEYS] = {
     "fallback_uniform", "__dict__"};
 static PyObject *keys[NKEYS];
 
+/* Seconds on the clock of time.perf_counter (its own C function). */
 static double seconds(void) {
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+#if PY_VERSION_HEX >= 0x030D0000
+    PyTime_t t;
+    if (PyTime_PerfCounterRaw(&t) < 0)
+        return 0.0; /* not reached: perf_counter's clock was checked when Python started */
+    return PyTime_AsSecondsDouble(t);
+#else
+    return _PyTime_AsSecondsDouble(_PyTime_GetPerfCounter());
+#endif
 }
 
-static PyObject *bind(PyObject *self, PyObject *args) {
+static PyObject *bind(PyObject *Py_UNUSED(self), PyObject *args) {
     unsigned long long address;
     PyObject *type, *fields;
     if (!PyArg_ParseTuple(args, "KO!O!:bind", &address, &PyType_Type, &type, &PyDict_Type,
@@ -63,7 +70,7 @@ static PyObject *bind(PyObject *self, PyObject *args) {
     Py_RETURN_NONE;
 }
 
-/* A new float64 (or int64) array of shape dims (ndim 1 or 2) holding n values from src. */
+/* A new 1-D or 2-D array of dtype type holding the bytes at src; NULL on an error. */
 static PyObject *filled(int ndim, npy_intp *dims, int type, const void *src, size_t bytes) {
     PyObject *a = PyArray_SimpleNew(ndim, dims, type);
     if (a != NULL)
@@ -71,50 +78,70 @@ static PyObject *filled(int ndim, npy_intp *dims, int type, const void *src, siz
     return a;
 }
 
-/* Set values[i] under keys[i] in dict for the n pairs, then drop the new references among them
- * (owned[i]); -1 on an error (every owned reference dropped all the same). */
-static int set_all(PyObject *dict, const int *which, PyObject **values, const int *owned, int n) {
-    int status = 0;
-    for (int i = 0; i < n; i++) {
-        if (values[i] == NULL || (status == 0 && PyDict_SetItem(dict, keys[which[i]], values[i])))
-            status = -1;
-    }
-    for (int i = 0; i < n; i++) {
-        if (owned[i])
-            Py_XDECREF(values[i]);
-    }
+/* dict[keys[key]] = value, then value's reference dropped (a new one, or NULL after an error:
+ * then -1, as on a failed set). */
+static int put(PyObject *dict, int key, PyObject *value) {
+    if (value == NULL)
+        return -1;
+    int status = PyDict_SetItem(dict, keys[key], value);
+    Py_DECREF(value);
     return status;
 }
 
-static PyObject *straight_result(PyObject *const *args, double d, double found, double *xy) {
+/* dict[keys[key]] = value, a borrowed reference. */
+static int put_borrowed(PyObject *dict, int key, PyObject *value) {
+    return PyDict_SetItem(dict, keys[key], value);
+}
+
+/* The fields of the straight answer in dict (a copy of the shared ones): 0, or -1 on an error
+ * (each step runs only after the ones before succeeded). */
+static int fill(PyObject *dict, PyObject *const *args, double d, double found, double *xy) {
     npy_intp path_dims[2] = {2, 2}, one = 1;
     int64_t root = 0;
+    if (put(dict, PATH, filled(2, path_dims, NPY_FLOAT64, xy, 4 * sizeof(double))) < 0 ||
+        put(dict, TRACE_ITERATIONS, filled(1, &one, NPY_INT64, &root, sizeof root)) < 0 ||
+        put(dict, TRACE_COSTS, filled(1, &one, NPY_FLOAT64, &d, sizeof d)) < 0)
+        return -1;
+    PyObject *cost = PyFloat_FromDouble(d); /* one float object for both fields, as in Python */
+    if (cost == NULL || put_borrowed(dict, FIRST_COST, cost) < 0) {
+        Py_XDECREF(cost);
+        return -1;
+    }
+    if (put(dict, COST, cost) < 0)
+        return -1;
+    PyObject *time = PyFloat_FromDouble(found);
+    if (time == NULL || put_borrowed(dict, TIME_TO_STOP, time) < 0) {
+        Py_XDECREF(time);
+        return -1;
+    }
+    if (put(dict, TIME_TO_FIRST, time) < 0)
+        return -1;
+    if (put_borrowed(dict, PLANNER, args[6]) < 0 ||
+        put_borrowed(dict, REFERENCE_LENGTH, args[7]) < 0 ||
+        put_borrowed(dict, TARGET_COST, args[5]) < 0 ||
+        put_borrowed(dict, SETUP_TIME, args[8]) < 0 ||
+        put_borrowed(dict, FALLBACK_UNIFORM, args[9]) < 0)
+        return -1;
+    return 0;
+}
+
+/* The PlanResult of the straight answer: object.__new__(PlanResult), its __dict__ the
+ * filled copy (object.__setattr__: the frozen class's own __setattr__ refuses). */
+static PyObject *straight_result(PyObject *const *args, double d, double found, double *xy) {
     PyObject *dict = PyDict_Copy(shared);
     if (dict == NULL)
         return NULL;
-    PyObject *cost = PyFloat_FromDouble(d), *time = PyFloat_FromDouble(found);
-    const int which[] = {PLANNER, PATH, COST, FIRST_COST, TIME_TO_FIRST, TIME_TO_STOP,
-                         TRACE_ITERATIONS, TRACE_COSTS, REFERENCE_LENGTH, TARGET_COST,
-                         SETUP_TIME, FALLBACK_UNIFORM};
-    PyObject *values[] = {args[6], filled(2, path_dims, NPY_FLOAT64, xy, 4 * sizeof(double)),
-                          cost, cost, time, time,
-                          filled(1, &one, NPY_INT64, &root, sizeof root),
-                          filled(1, &one, NPY_FLOAT64, &d, sizeof d),
-                          args[7], args[5], args[8], args[9]};
-    const int owned[] = {0, 1, 1, 0, 1, 0, 1, 1, 0, 0, 0, 0}; /* cost and time set twice */
-    if (set_all(dict, which, values, owned, 12) < 0) {
-        Py_DECREF(dict);
-        return NULL;
+    PyObject *result = NULL;
+    if (fill(dict, args, d, found, xy) == 0) {
+        result = PyBaseObject_Type.tp_new((PyTypeObject *)result_type, empty_args, NULL);
+        if (result != NULL && PyObject_GenericSetAttr(result, keys[DICT], dict) < 0)
+            Py_CLEAR(result);
     }
-    PyObject *result = PyBaseObject_Type.tp_new((PyTypeObject *)result_type, empty_args, NULL);
-    if (result != NULL && PyObject_GenericSetAttr(result, keys[DICT], dict) < 0)
-        Py_CLEAR(result); /* object.__setattr__(result, "__dict__", dict): the frozen class's
-                             own __setattr__ refuses */
     Py_DECREF(dict);
     return result;
 }
 
-static PyObject *answer(PyObject *self, PyObject *const *args, Py_ssize_t nargs) {
+static PyObject *answer(PyObject *Py_UNUSED(self), PyObject *const *args, Py_ssize_t nargs) {
     if (nargs != 10) {
         PyErr_Format(PyExc_TypeError, "answer takes 10 arguments, got %zd", nargs);
         return NULL;
@@ -156,9 +183,13 @@ static PyMethodDef methods[] = {
      "answer(occ, sx, sy, gx, gy, target, planner, reference_length, setup_time, fallback)"},
     {NULL, NULL, 0, NULL}};
 
-static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, "_straight",
-                                    "The free straight segment's answer in one C call.", -1,
-                                    methods};
+static struct PyModuleDef module = {
+    .m_base = PyModuleDef_HEAD_INIT,
+    .m_name = "_straight",
+    .m_doc = "The free straight segment's answer in one C call.",
+    .m_size = -1,
+    .m_methods = methods,
+};
 
 PyMODINIT_FUNC PyInit__straight(void) {
     import_array();

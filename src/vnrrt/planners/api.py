@@ -462,4 +462,5 @@ def warmup() -> None:
             p._run(query, 0, run.straight_test(occ, 1.5, 3.5, 6.5, 3.5, True))
     tested = run.straight_test(occ, 1.5, 3.5, 6.5, 3.5, False)
     Planner(occ, config=PlannerConfig(max_iterations=200, gap_share=0.5))._run(query, 0, tested)
+    answerer()  # the free segment's C answer bound (its kernel compiled as a C function)
     log.debug("planner kernels compiled")

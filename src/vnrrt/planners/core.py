@@ -36,7 +36,7 @@ import math
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit
+from numba import carray, njit
 
 from vnrrt.planners import spatial
 from vnrrt.planners.collision import points_free, segment_free
@@ -223,6 +223,14 @@ def query_test(occ, sx, sy, gx, gy, straight):
     if not straight:
         return -1.0
     return straight_cost(occ, sx, sy, gx, gy)
+
+
+def query_test_at(ptr, h, w, sx, sy, gx, gy):
+    """:func:`query_test` with the straight segment tested, on the ``(h, w)`` C-order uint8
+    grid at address ``ptr``: compiled as a C function by :func:`vnrrt.planners.native.answerer`
+    (at first use, not at import), defined here so that numba's cache of it goes with this
+    file (and, like every kernel's, not with its callees': ``make clean``)."""
+    return query_test(carray(ptr, (h, w)), sx, sy, gx, gy, True)
 
 
 @njit(cache=True)
