@@ -3,7 +3,9 @@ does least: the run of a free straight segment, one compiled call (``core.query_
 
 On each of the development maps whose straight segment is free, the median over ``--calls``
 calls of: a Python function of the same six arguments (the baseline), a trivial compiled
-(numba) function of them, and our run's compiled call; each timed cold (right after ``--flush``
+(numba) function of them, our run's compiled call through numba's dispatch, the C answer
+(:mod:`vnrrt.planners.native`: the same test called through its C address, and the result)
+and the whole ``plan()`` call that uses it; each timed cold (right after ``--flush``
 MB of a buffer are written and read, as ``bench_planners.py --flush``) and warm (back to back).
 The ratios are to the Python call measured in the same run. It shows where a cold run's time
 goes: the compiled call's dispatch (argument typing, unboxing) against the segment test.
@@ -14,6 +16,8 @@ goes: the compiled call's dispatch (argument typing, unboxing) against the segme
 from __future__ import annotations
 
 import argparse
+import functools
+import math
 import time
 
 import numpy as np
@@ -21,7 +25,9 @@ from numba import njit
 
 from bench_planners import flush_here
 from planner_maps import dev_instances
-from vnrrt.planners import core, segment_free, warmup
+from vnrrt.planners import FASTEST, core, plan, segment_free, warmup
+from vnrrt.planners.native import answerer
+from vnrrt.planners.run import free_answer
 
 
 @njit(cache=True)
@@ -55,19 +61,30 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
     warmup()
     nbytes = int(args.flush * 2**20)
-    figures = {"python call": python, "compiled no-op": trivial, "our run": core.query_test}
-    print(f"median us over {args.calls} calls; cold: after a {args.flush:g} MB flush")
-    print(f"{'map':<10}" + "".join(f"{f + ' cold':>20}{'warm':>7}" for f in figures))
-    ratios = {f: [] for f in figures}
+    answer = answerer()
+    kind = "the C one" if answer is not free_answer else "not built: the Python one"
+    print(f"median us over {args.calls} calls; cold: after a {args.flush:g} MB flush; "
+          f"'C answer': {kind}")  # fmt: skip
+    labels = ("python call", "compiled no-op", "our run", "C answer", "plan() call")
+    print(f"{'map':<10}" + "".join(f"{f + ' cold':>20}{'warm':>7}" for f in labels))
+    ratios = {f: [] for f in labels}
     for name, g, s, e in dev_instances():
         occ = np.ascontiguousarray(g, np.uint8)
         xy = (*map(float, s), *map(float, e))
         if not segment_free(occ, *xy):
             continue
-        args_ = (occ, *xy, True)
+        d = math.hypot(xy[2] - xy[0], xy[3] - xy[1])
+        ask = {"stop": "optimal", "reference_length": d, "seed": 0, "config": FASTEST}
+        figures = {
+            "python call": (python, (occ, *xy, True)),
+            "compiled no-op": (trivial, (occ, *xy, True)),
+            "our run": (core.query_test, (occ, *xy, True)),  # through numba's dispatch
+            "C answer": (answer, (occ, *xy, 1.01 * d, "rrt_star", d, 0.0, False)),
+            "plan() call": (functools.partial(plan, occ, xy[:2], xy[2:], **ask), ()),
+        }
         row = f"{name:<10}"
         base = None
-        for label, fn in figures.items():
+        for label, (fn, args_) in figures.items():
             fn(*args_)  # compiled (or loaded) before timing
             cold = median_us(fn, args_, args.calls, nbytes)
             warm = median_us(fn, args_, 20 * args.calls, 0)
