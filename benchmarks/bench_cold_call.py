@@ -26,8 +26,7 @@ from numba import njit
 from bench_planners import flush_here
 from planner_maps import dev_instances
 from vnrrt.planners import FASTEST, core, plan, segment_free, warmup
-from vnrrt.planners.native import answerer
-from vnrrt.planners.run import free_answer
+from vnrrt.planners.native import answerer, described
 
 
 @njit(cache=True)
@@ -62,9 +61,8 @@ def main(argv: list[str] | None = None) -> int:
     warmup()
     nbytes = int(args.flush * 2**20)
     answer = answerer()
-    kind = "the C one" if answer is not free_answer else "not built: the Python one"
-    print(f"median us over {args.calls} calls; cold: after a {args.flush:g} MB flush; "
-          f"'C answer': {kind}")  # fmt: skip
+    print(described())  # the 'C answer' column is the Python one where C is not built
+    print(f"median us over {args.calls} calls; cold: after a {args.flush:g} MB flush")
     labels = ("python call", "compiled no-op", "our run", "C answer", "plan() call")
     print(f"{'map':<10}" + "".join(f"{f + ' cold':>20}{'warm':>7}" for f in labels))
     ratios = {f: [] for f in labels}

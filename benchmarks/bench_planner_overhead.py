@@ -33,7 +33,7 @@ import numpy as np
 import ompl_native
 from planner_maps import dev_instances, held_out_instances
 from vnrrt.planners import FASTEST, Planner, any_angle_path, plan, segment_free, warmup
-from vnrrt.planners.native import built as answered_in_c
+from vnrrt.planners.native import described
 
 NATIVE = ("BITstar", "ABITstar", "AITstar", "InformedRRTstar")
 EASY = ("open", "random1", "random11")
@@ -90,8 +90,7 @@ def main(argv: list[str] | None = None) -> int:
     if binary is None:
         return 2
     warmup()
-    print(f"free straight segments answered in {'C' if answered_in_c() else 'Python'} "
-          "(vnrrt.planners.native)")  # fmt: skip
+    print(described())
     maps = [m for m in dev_instances() + held_out_instances()
             if segment_free(m[1], *m[2], *m[3]) or m[0] in EASY]  # fmt: skip
     print(f"median us over {args.calls} calls in alternating blocks of {args.block}; "

@@ -61,7 +61,7 @@ import ompl_native
 import ompl_python
 from planner_maps import dev_instances, held_out_instances
 from vnrrt.planners import FASTEST, PlannerConfig, any_angle_path, path_free, plan, warmup
-from vnrrt.planners.native import built as answered_in_c
+from vnrrt.planners.native import described
 
 ETA, BEST_ETA = 10.0, FASTEST.eta
 OURS = {"ours-best": FASTEST, "ours-rrt*": PlannerConfig(eta=ETA)}
@@ -282,8 +282,7 @@ def main(argv: list[str] | None = None) -> int:
     if not args.no_python:
         ompl_python.quiet(args.seed + 1)
     warmup()  # JIT compilation (or cache load) outside every timing
-    print(f"free straight segments answered in {'C' if answered_in_c() else 'Python'} "
-          "(vnrrt.planners.native)")  # fmt: skip
+    print(described())
     sets = {"dev": dev_instances, "held_out": held_out_instances}
     good = True
     with ompl_native.Harness(binary, args.seed + 1) as native:

@@ -175,12 +175,18 @@ def straight_test(occ: np.ndarray, sx: float, sy: float, gx: float, gy: float,
     return d, (time.perf_counter() - t0 if straight else 0.0)
 
 
+def straight_meets(d: float, target: float | None) -> bool:
+    """Whether a straight segment of length ``d`` (:func:`straight_test`'s: < 0 when blocked
+    or not tested) answers a query with stop bound ``target`` (None: any length)."""
+    return d >= 0 and (target is None or d <= target)
+
+
 def straight_answer(planner: str, query: Query, tested: tuple[float, float]) -> PlanResult | None:
     """The run's result when the straight segment ``tested`` (:func:`straight_test`: its
     length, -1 when blocked, and the seconds taken) meets the query's stop rule, else None
     (a tree is needed)."""
     d, found = tested
-    if d >= 0 and (query.target is None or d <= query.target):
+    if straight_meets(d, query.target):
         return straight_result(planner, d, found, *query)
     return None
 
@@ -203,7 +209,7 @@ def free_answer(
     :mod:`vnrrt.planners.native`'s C one."""
     tested = straight_test(occ, sx, sy, gx, gy, True)
     d, found = tested
-    if d < 0 or (target is not None and d > target):
+    if not straight_meets(d, target):
         return tested
     return straight_result(planner, d, found, (sx, sy), (gx, gy), target, (), False,
                            reference_length, setup_time, fallback_uniform)  # fmt: skip
