@@ -330,6 +330,14 @@ def answers(request, monkeypatch) -> types.SimpleNamespace:
     assert (real is not run.free_answer) is (request.param == "c"), "the C answer is not built"
     seen = types.SimpleNamespace(kind=request.param, calls=[])
     monkeypatch.setattr(api, "answerer", lambda: lambda *a: seen.calls.append(a) or real(*a))
+
+    def planned(*args):  # plan()'s common form in C (which tests the segment when it answers
+        answer = native.planned(*args)  # other than None)
+        if answer is not None:
+            seen.calls.append(args)
+        return answer
+
+    monkeypatch.setattr(api, "planned", planned if request.param == "c" else native._not_built)
     return seen
 
 

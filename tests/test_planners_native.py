@@ -13,7 +13,7 @@ import weakref
 import numpy as np
 import pytest
 
-from vnrrt.planners import native, run
+from vnrrt.planners import PlannerConfig, make_sampler, native, plan, run
 from vnrrt.planners.result import FIELDS, PlanResult
 
 TIMES = ("time_to_first", "time_to_stop")
@@ -153,6 +153,7 @@ def test_the_python_answer_is_used_where_the_c_one_is_missing_or_cannot_be_bound
     from vnrrt.planners import api
 
     monkeypatch.setattr(api, "answerer", lambda: run.free_answer)
+    monkeypatch.setattr(api, "planned", native._not_built)
     got = plan(occ, (1.5, 1.5), (17.5, 12.5), config=FASTEST)
     assert (got.cost, got.iterations, got.path.tolist()) == (want.cost, 0, want.path.tolist())
 
@@ -178,14 +179,16 @@ def test_the_c_answer_refuses_what_it_cannot_read(c_answer, args, match):
 
 
 def test_an_unbound_c_answer_raises_and_a_zero_address_is_refused():
-    """Before bind() the C answer raises instead of calling nothing; bind() refuses a zero
-    kernel address (in a fresh process: this one's module is bound)."""
+    """Before bind() the C answer raises instead of calling nothing, and plan()'s answers None
+    (plan() then takes its Python path); bind() refuses a zero kernel address (in a fresh
+    process: this one's module is bound)."""
     code = (
         "import numpy as np\n"
         "from vnrrt.planners import _straight as s\n"
         "occ = np.zeros((4, 4), np.uint8)\n"
+        "print(s.plan(occ, (1.5, 1.5), (2.5, 2.5), 'rrt_star', *[None] * 5, 0, (), False))\n"
         "for call in (lambda: s.answer(occ, 1.5, 1.5, 2.5, 2.5, None, 'p', None, 0.0, False),\n"
-        "             lambda: s.bind(0, type, {})):\n"
+        "             lambda: s.bind(0, type, {}, type)):\n"
         "    try:\n"
         "        call()\n"
         "    except (RuntimeError, ValueError) as e:\n"
@@ -193,6 +196,168 @@ def test_an_unbound_c_answer_raises_and_a_zero_address_is_refused():
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.splitlines() == [
+        "None",  # plan()'s C answer, unbound: the Python path
         "RuntimeError answer: no kernel bound (call bind first)",
         "ValueError bind: the kernel address is 0",
     ]
+
+
+class Str(str):
+    """A str subclass: not plan()'s common form (its Python path compares it)."""
+
+
+class Config(PlannerConfig):
+    """A PlannerConfig subclass: not plan()'s common form."""
+
+
+def outcome(fn, *args, **kwargs):
+    """``fn(*args, **kwargs)``'s result, or its exception's type and message."""
+    try:
+        return fn(*args, **kwargs)
+    except Exception as error:
+        return type(error), str(error)
+
+
+def assert_same_outcome(a, b) -> None:
+    """The same exception, or results equal field by field (times and the measured setup
+    time apart; milestones by bound and iteration), scalars of the same type."""
+    assert type(a) is type(b)
+    if type(a) is tuple:
+        assert a == b
+        return
+    for name in FIELDS - {*TIMES, "setup_time", "milestones"}:
+        x, y = getattr(a, name), getattr(b, name)
+        assert type(x) is type(y), name
+        if isinstance(x, np.ndarray):
+            assert (x.dtype, x.shape) == (y.dtype, y.shape), name
+            np.testing.assert_array_equal(x, y, err_msg=name)
+        else:
+            assert x == y or (x != x and y != y), name
+    assert [(m.bound, m.iteration) for m in a.milestones] == [
+        (m.bound, m.iteration) for m in b.milestones
+    ]
+
+
+ODD_SEEDS = [(1, 2), (), [1, 2], np.int64(3), True, (1, -2), -1, 2**70, (2**70,), 1.5]
+
+
+def plan_arguments(rng, occ: np.ndarray, configs: list, n: int):
+    """``n`` random argument sets of plan() on ``occ``, each argument mostly of the common form
+    (free points as tuples of floats, RRT*, a validated config with straight_first, an int
+    seed...) and otherwise of one of the forms plan()'s Python path reads or refuses."""
+    h, w = occ.shape
+    free = np.argwhere(occ == 0)
+    grids = [occ, occ.astype(bool), np.asfortranarray(occ), occ.astype(np.int64), occ.tolist(),
+             occ.view(np.dtype(np.uint8, metadata={"m": 1})), np.zeros(5, np.uint8),
+             occ[:, :]]  # fmt: skip
+
+    def pick(common, odd, p=0.75):
+        return common if rng.random() < p else odd[rng.integers(len(odd))]
+
+    def point():
+        y, x = free[rng.integers(len(free))]
+        x, y = float(x) + 0.5, float(y) + 0.5
+        odd = [(np.float64(x), np.float64(y)), [x, y], np.array([x, y]), (np.float32(x), y),
+               (int(x), int(y)), (True, y), (x, y, 1.0), (str(x), y), (math.nan, y),
+               (math.inf, y), (1e308, 1e308), (10**400, y), (-x, y), (x + w, y), x]  # fmt: skip
+        return pick((x, y), odd, 0.8)
+
+    for _ in range(n):
+        start, goal = point(), point()
+        try:
+            d = math.dist(start, goal)
+        except (TypeError, ValueError, OverflowError):
+            d = 10.0
+        d = d if math.isfinite(d) else 10.0
+        refs = [None, int(math.ceil(d)), 0, 0.0, -1.0, math.nan, math.inf, np.float64(d), True,
+                10**400, "a", 0.5 * d, d]  # fmt: skip
+        yield (
+            pick(occ, grids, 0.85),
+            start,
+            goal,
+            pick("rrt_star", ["nrrt_star", Str("rrt_star"), "bogus"], 0.9),
+            {
+                "heatmap": pick(None, [np.ones((h, w))], 0.95),
+                "sampler": pick(None, [make_sampler("rrt_star", (h, w))], 0.95),
+                "config": pick(configs[0], configs[1:], 0.7),
+                "stop": pick(("initial", "optimal")[rng.integers(2)], ["best", Str("optimal")]),
+                "reference_length": pick(d * rng.uniform(0.95, 1.2), refs, 0.6),
+                "seed": pick(int(rng.integers(100)), ODD_SEEDS, 0.7),
+                "milestones": pick((), [(3.0,), [], np.array([])], 0.9),
+                "keep_tree": pick(False, [True, 0, None], 0.9),
+            },
+        )
+
+
+def test_plans_c_answer_is_its_python_paths(c_answer, monkeypatch):
+    """plan() with its common form answered in C (native.planned) answers as plan() in Python
+    does, on random arguments of every form (valid or not: the same result, times apart, or
+    the same error); the C one answers only the common form (RRT*, no heatmap or sampler, a
+    validated config with straight_first, the grid used in place, points of two floats, ints
+    or float64s, a float or int reference, an int seed or a tuple of them, no milestones,
+    keep_tree False), which plan()'s Python path answers in one pass too."""
+    from vnrrt.planners import api
+
+    rng = np.random.default_rng(5)
+    occ = random_map(rng, 24, 30, 0.04)  # sparse: many free segments
+    base = PlannerConfig(straight_first=True, max_iterations=40)
+    base.validate()
+    configs = [
+        base,
+        base.replace(straight_first=False),
+        base.replace(eps=0),
+        base.replace(eps=np.float64(0.02)),
+        Config(straight_first=True),
+        None,
+        "cfg",
+    ]
+    for c in configs[1:4]:
+        c.validate()
+    kinds = []
+    for grid, start, goal, planner, kw in plan_arguments(rng, occ, configs, 1500):
+        if type(kw["config"]) is PlannerConfig and rng.random() < 0.1:  # one not yet validated
+            kw["config"] = kw["config"].replace(max_iterations=41)
+        ordered = [kw[k] for k in ("heatmap", "config", "sampler", "stop", "reference_length",
+                                   "seed", "milestones", "keep_tree")]  # fmt: skip
+        pre = outcome(native.planned, grid, start, goal, planner, *ordered)
+        with monkeypatch.context() as m:
+            m.setattr(api, "planned", native._not_built)
+            python = outcome(plan, grid, start, goal, planner, **kw)
+        c = outcome(plan, grid, start, goal, planner, **kw)
+        assert_same_outcome(c, python)
+        kind = "none" if pre is None else type(pre).__name__
+        kinds.append(kind)
+        if kind == "PlanResult":
+            assert_same_outcome(pre, python)
+            assert (pre.iterations, pre.setup_time, python.setup_time) == (0, 0.0, 0.0)
+        else:
+            assert kind in ("none", "tuple"), pre  # never an error
+    counts = {k: kinds.count(k) for k in set(kinds)}
+    assert counts["PlanResult"] > 100 and counts["tuple"] > 60 and counts["none"] > 500, counts
+
+
+def test_plans_c_answer_leaves_nothing_behind(c_answer):
+    """plan()'s C answer (a result, a tested segment's tuple, None for another form) leaves
+    no object behind over repeated calls and the reference counts of its arguments as they
+    were; it refuses a wrong argument count."""
+    occ = np.zeros((30, 30), np.uint8)
+    occ[10:20, 15] = 1
+    cfg = PlannerConfig(straight_first=True)
+    cfg.validate()
+    start, free, blocked, ref = (3.5, 14.5), (12.5, 3.5), (25.5, 14.5), 40.0
+    calls = [(free, "optimal", ref), (blocked, "optimal", ref), (free, "optimal", 2.0),
+             (free, "initial", None), (free, "best", ref)]  # fmt: skip
+    kinds = [type(native.planned(occ, start, g, "rrt_star", None, cfg, None, stop, r, (1, 2),
+                                 (), False)) for g, stop, r in calls]  # fmt: skip
+    assert kinds == [PlanResult, tuple, tuple, PlanResult, type(None)]
+    watched = (occ, cfg, cfg.__dict__, start, free, blocked, ref)
+    counts = [sys.getrefcount(x) for x in watched]
+    blocks = sys.getallocatedblocks()
+    for _ in range(3000):
+        for g, stop, r in calls:
+            native.planned(occ, start, g, "rrt_star", None, cfg, None, stop, r, (1, 2), (), False)
+    del g, stop, r  # the loop's names
+    assert sys.getallocatedblocks() - blocks < 100
+    assert [sys.getrefcount(x) for x in watched] == counts
+    with pytest.raises(TypeError, match="12 arguments"):
+        native.planned(occ, start, free)

@@ -20,10 +20,12 @@
  */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
+#include <math.h>
 #include <stdint.h>
 #include <string.h>
 #define NPY_NO_DEPRECATED_API NPY_1_7_API_VERSION
 #include <numpy/arrayobject.h>
+#include <numpy/arrayscalars.h>
 
 typedef double (*kernel_fn)(const uint8_t *, npy_intp, npy_intp, double, double, double, double);
 
@@ -31,14 +33,21 @@ static kernel_fn kernel = NULL;
 static PyObject *result_type = NULL; /* PlanResult */
 static PyObject *shared = NULL;      /* the fields every straight answer shares */
 static PyObject *empty_args = NULL;  /* () for object.__new__ */
+static PyObject *config_type = NULL; /* PlannerConfig */
+static PyObject *zero = NULL;        /* 0.0: plan()'s setup_time */
+static PyArray_Descr *uint8_descr = NULL; /* numpy's uint8 dtype object */
 
 enum { PLANNER, PATH, COST, FIRST_COST, TIME_TO_FIRST, TIME_TO_STOP, TRACE_ITERATIONS,
-       TRACE_COSTS, REFERENCE_LENGTH, TARGET_COST, SETUP_TIME, FALLBACK_UNIFORM, DICT, NKEYS };
+       TRACE_COSTS, REFERENCE_LENGTH, TARGET_COST, SETUP_TIME, FALLBACK_UNIFORM, DICT, VALID,
+       STRAIGHT, EPS, NKEYS };
 static const char *key_names[NKEYS] = {
     "planner", "path", "cost", "first_cost", "time_to_first", "time_to_stop",
     "trace_iterations", "trace_costs", "reference_length", "target_cost", "setup_time",
-    "fallback_uniform", "__dict__"};
+    "fallback_uniform", "__dict__", "_valid", "straight_first", "eps"};
 static PyObject *keys[NKEYS];
+enum { RRT_STAR, INITIAL, OPTIMAL, NSTRS };
+static const char *str_values[NSTRS] = {"rrt_star", "initial", "optimal"};
+static PyObject *strs[NSTRS];
 
 /* Seconds on the clock of time.perf_counter (its own C function). */
 static double seconds(void) {
@@ -54,9 +63,9 @@ static double seconds(void) {
 
 static PyObject *bind(PyObject *Py_UNUSED(self), PyObject *args) {
     unsigned long long address;
-    PyObject *type, *fields;
-    if (!PyArg_ParseTuple(args, "KO!O!:bind", &address, &PyType_Type, &type, &PyDict_Type,
-                          &fields))
+    PyObject *type, *fields, *config;
+    if (!PyArg_ParseTuple(args, "KO!O!O!:bind", &address, &PyType_Type, &type, &PyDict_Type,
+                          &fields, &PyType_Type, &config))
         return NULL;
     if (address == 0) {
         PyErr_SetString(PyExc_ValueError, "bind: the kernel address is 0");
@@ -66,6 +75,8 @@ static PyObject *bind(PyObject *Py_UNUSED(self), PyObject *args) {
     Py_XSETREF(result_type, type);
     Py_INCREF(fields);
     Py_XSETREF(shared, fields);
+    Py_INCREF(config);
+    Py_XSETREF(config_type, config);
     kernel = (kernel_fn)(uintptr_t)address;
     Py_RETURN_NONE;
 }
@@ -95,7 +106,7 @@ static int put_borrowed(PyObject *dict, int key, PyObject *value) {
 
 /* The fields of the straight answer in dict (a copy of the shared ones): 0, or -1 on an error
  * (each step runs only after the ones before succeeded). */
-static int fill(PyObject *dict, PyObject *const *args, double d, double found, double *xy) {
+static int fill(PyObject *dict, PyObject *const *given, double d, double found, double *xy) {
     npy_intp path_dims[2] = {2, 2}, one = 1;
     int64_t root = 0;
     if (put(dict, PATH, filled(2, path_dims, NPY_FLOAT64, xy, 4 * sizeof(double))) < 0 ||
@@ -116,28 +127,48 @@ static int fill(PyObject *dict, PyObject *const *args, double d, double found, d
     }
     if (put(dict, TIME_TO_FIRST, time) < 0)
         return -1;
-    if (put_borrowed(dict, PLANNER, args[6]) < 0 ||
-        put_borrowed(dict, REFERENCE_LENGTH, args[7]) < 0 ||
-        put_borrowed(dict, TARGET_COST, args[5]) < 0 ||
-        put_borrowed(dict, SETUP_TIME, args[8]) < 0 ||
-        put_borrowed(dict, FALLBACK_UNIFORM, args[9]) < 0)
+    if (put_borrowed(dict, TARGET_COST, given[0]) < 0 ||
+        put_borrowed(dict, PLANNER, given[1]) < 0 ||
+        put_borrowed(dict, REFERENCE_LENGTH, given[2]) < 0 ||
+        put_borrowed(dict, SETUP_TIME, given[3]) < 0 ||
+        put_borrowed(dict, FALLBACK_UNIFORM, given[4]) < 0)
         return -1;
     return 0;
 }
 
 /* The PlanResult of the straight answer: object.__new__(PlanResult), its __dict__ the
- * filled copy (object.__setattr__: the frozen class's own __setattr__ refuses). */
-static PyObject *straight_result(PyObject *const *args, double d, double found, double *xy) {
+ * filled copy (object.__setattr__: the frozen class's own __setattr__ refuses); given: the
+ * objects target, planner, reference_length, setup_time, fallback (borrowed). */
+static PyObject *straight_result(PyObject *const *given, double d, double found, double *xy) {
     PyObject *dict = PyDict_Copy(shared);
     if (dict == NULL)
         return NULL;
     PyObject *result = NULL;
-    if (fill(dict, args, d, found, xy) == 0) {
+    if (fill(dict, given, d, found, xy) == 0) {
         result = PyBaseObject_Type.tp_new((PyTypeObject *)result_type, empty_args, NULL);
         if (result != NULL && PyObject_GenericSetAttr(result, keys[DICT], dict) < 0)
             Py_CLEAR(result);
     }
     Py_DECREF(dict);
+    return result;
+}
+
+/* The kernel's test of the segment xy on occ, timed: the straight answer's PlanResult when it
+ * is free and its length meets target (INFINITY: any), else the tuple (d, seconds). given:
+ * as straight_result's, given[0] (the target object) NULL when it is made here from target
+ * (only for a result). */
+static PyObject *tested(PyArrayObject *occ, double *xy, double target, PyObject **given) {
+    double t0 = seconds();
+    double d = kernel(PyArray_DATA(occ), PyArray_DIM(occ, 0), PyArray_DIM(occ, 1), xy[0], xy[1],
+                      xy[2], xy[3]);
+    double found = seconds() - t0;
+    if (d < 0 || d > target)
+        return Py_BuildValue("(dd)", d, found);
+    if (given[0] != NULL)
+        return straight_result(given, d, found, xy);
+    PyObject *made = given[0] = PyFloat_FromDouble(target);
+    PyObject *result = made == NULL ? NULL : straight_result(given, d, found, xy);
+    Py_XDECREF(made);
     return result;
 }
 
@@ -168,19 +199,149 @@ static PyObject *answer(PyObject *Py_UNUSED(self), PyObject *const *args, Py_ssi
         if (target == -1.0 && PyErr_Occurred())
             return NULL;
     }
-    double t0 = seconds();
-    double d = kernel(PyArray_DATA(occ), PyArray_DIM(occ, 0), PyArray_DIM(occ, 1), xy[0], xy[1],
-                      xy[2], xy[3]);
-    double found = seconds() - t0;
-    if (d < 0 || d > target)
-        return Py_BuildValue("(dd)", d, found);
-    return straight_result(args, d, found, xy);
+    PyObject *given[5] = {args[5], args[6], args[7], args[8], args[9]};
+    return tested(occ, xy, target, given);
+}
+
+/* plan()'s common form, recognised without the interpreter. Each check below answers 1 when
+ * its argument has that form (then its value is stored), else 0: plan() then takes its
+ * Python path, which checks every argument and raises its errors. None of them raises. */
+
+/* v is the str s (s interned). */
+static int is_str(PyObject *v, PyObject *s) {
+    return v == s || (PyUnicode_CheckExact(v) && PyUnicode_Compare(v, s) == 0);
+}
+
+/* v is a float, an int (not a bool) or a numpy float64, as a double (float(v)). */
+static int number(PyObject *v, double *out) {
+    if (PyFloat_CheckExact(v)) {
+        *out = PyFloat_AS_DOUBLE(v);
+        return 1;
+    }
+    if (Py_IS_TYPE(v, &PyDoubleArrType_Type)) {
+        *out = PyArrayScalar_VAL(v, Double);
+        return 1;
+    }
+    if (!PyLong_CheckExact(v))
+        return 0;
+    *out = PyLong_AsDouble(v);
+    if (*out == -1.0 && PyErr_Occurred()) {
+        PyErr_Clear(); /* too large for a double: Python's float() raises it */
+        return 0;
+    }
+    return 1;
+}
+
+/* start and goal each a tuple or list of two numbers (number()), their sum finite: xy is
+ * (sx, sy, gx, gy) as api._floats makes it. */
+static int points(PyObject *start, PyObject *goal, double *xy) {
+    PyObject *p[2] = {start, goal};
+    for (int k = 0; k < 2; k++) {
+        if (!(PyTuple_CheckExact(p[k]) || PyList_CheckExact(p[k])) ||
+            PySequence_Fast_GET_SIZE(p[k]) != 2)
+            return 0;
+        PyObject **items = PySequence_Fast_ITEMS(p[k]);
+        if (!number(items[0], xy + 2 * k) || !number(items[1], xy + 2 * k + 1))
+            return 0;
+    }
+    return isfinite(xy[0] + xy[1] + xy[2] + xy[3]);
+}
+
+/* v is an int >= 0 (not a bool). */
+static int natural(PyObject *v) {
+    if (!PyLong_CheckExact(v))
+        return 0;
+    int overflow;
+    long long x = PyLong_AsLongLongAndOverflow(v, &overflow);
+    return overflow > 0 || (overflow == 0 && x >= 0);
+}
+
+/* seed an int >= 0 or a tuple of them (api._seed_ok's fast cases). */
+static int seed_ok(PyObject *seed) {
+    if (PyLong_CheckExact(seed))
+        return natural(seed);
+    if (!PyTuple_CheckExact(seed))
+        return 0;
+    for (Py_ssize_t i = 0; i < PyTuple_GET_SIZE(seed); i++)
+        if (!natural(PyTuple_GET_ITEM(seed, i)))
+            return 0;
+    return 1;
+}
+
+/* occ is used in place by the planners (api._occupancy): an exact ndarray of numpy's uint8
+ * dtype object, 2-D, at least 2x2, C-contiguous. */
+static int grid_ok(PyObject *grid) {
+    if (!PyArray_CheckExact(grid))
+        return 0;
+    PyArrayObject *occ = (PyArrayObject *)grid;
+    return PyArray_DESCR(occ) == uint8_descr && PyArray_NDIM(occ) == 2 &&
+           PyArray_DIM(occ, 0) >= 2 && PyArray_DIM(occ, 1) >= 2 && PyArray_IS_C_CONTIGUOUS(occ);
+}
+
+/* config a PlannerConfig (not a subclass) already validated, with straight_first true and an
+ * eps that is a float or an int: *eps its value. */
+static int config_ok(PyObject *config, double *eps) {
+    if (!Py_IS_TYPE(config, (PyTypeObject *)config_type))
+        return 0;
+    PyObject *dict = PyObject_GenericGetDict(config, NULL);
+    if (dict == NULL || !PyDict_CheckExact(dict)) {
+        PyErr_Clear();
+        Py_XDECREF(dict);
+        return 0;
+    }
+    /* borrowed: the frozen config's dict keeps them */
+    PyObject *valid = PyDict_GetItemWithError(dict, keys[VALID]);
+    PyObject *straight = valid == NULL ? NULL : PyDict_GetItemWithError(dict, keys[STRAIGHT]);
+    PyObject *e = straight == NULL ? NULL : PyDict_GetItemWithError(dict, keys[EPS]);
+    int ok = e != NULL && valid == Py_True && straight == Py_True &&
+             PyFloat_CheckExact(e) != PyLong_CheckExact(e) && number(e, eps);
+    PyErr_Clear(); /* a lookup's error, if any: Python's path */
+    Py_DECREF(dict);
+    return ok;
+}
+
+/* plan(grid, start, goal, planner, heatmap, config, sampler, stop, reference_length, seed,
+ * milestones, keep_tree): its answer when the arguments have plan()'s common form (RRT*, no
+ * heatmap or sampler, a validated config with straight_first, the grid used in place, points
+ * of two numbers, stop 'initial' or 'optimal' with a float or int reference_length finite
+ * and >= 0 (optional for 'initial'), a seed int >= 0 or a tuple of them, milestones (),
+ * keep_tree False): the straight answer's PlanResult, or the tuple (d, seconds) of a segment
+ * tested that does not answer; None when the arguments have another form or no kernel is
+ * bound (plan() then checks them in Python). */
+static PyObject *plan(PyObject *Py_UNUSED(self), PyObject *const *args, Py_ssize_t nargs) {
+    if (nargs != 12) {
+        PyErr_Format(PyExc_TypeError, "plan takes 12 arguments, got %zd", nargs);
+        return NULL;
+    }
+    PyObject *grid = args[0], *stop = args[7], *reference = args[8];
+    double xy[4], eps, length = 0.0;
+    if (kernel == NULL || !is_str(args[3], strs[RRT_STAR]) || args[4] != Py_None ||
+        args[6] != Py_None || args[11] != Py_False || !PyTuple_CheckExact(args[10]) ||
+        PyTuple_GET_SIZE(args[10]) != 0 || !seed_ok(args[9]) || !config_ok(args[5], &eps) ||
+        !grid_ok(grid) || !points(args[1], args[2], xy))
+        Py_RETURN_NONE;
+    int optimal = is_str(stop, strs[OPTIMAL]);
+    if (!optimal && !is_str(stop, strs[INITIAL]))
+        Py_RETURN_NONE;
+    if (reference != Py_None) {
+        if (PyFloat_CheckExact(reference) == PyLong_CheckExact(reference) ||
+            !number(reference, &length) || !(length >= 0 && length < INFINITY))
+            Py_RETURN_NONE;
+    } else if (optimal) {
+        Py_RETURN_NONE; /* the reference is computed: Python's path */
+    }
+    PyObject *given[5] = {optimal ? NULL : Py_None, strs[RRT_STAR], reference, zero, Py_False};
+    return tested((PyArrayObject *)grid, xy, optimal ? (1.0 + eps) * length : INFINITY, given);
 }
 
 static PyMethodDef methods[] = {
-    {"bind", bind, METH_VARARGS, "bind(kernel_address, result_type, fields): see the module."},
+    {"bind", bind, METH_VARARGS,
+     "bind(kernel_address, result_type, fields, config_type): see the module."},
     {"answer", (PyCFunction)(void (*)(void))answer, METH_FASTCALL,
      "answer(occ, sx, sy, gx, gy, target, planner, reference_length, setup_time, fallback)"},
+    {"plan", (PyCFunction)(void (*)(void))plan, METH_FASTCALL,
+     "plan(grid, start, goal, planner, heatmap, config, sampler, stop, reference_length, seed, "
+     "milestones, keep_tree)"},
     {NULL, NULL, 0, NULL}};
 
 static struct PyModuleDef module = {
@@ -198,8 +359,15 @@ PyMODINIT_FUNC PyInit__straight(void) {
         if (keys[i] == NULL)
             return NULL;
     }
+    for (int i = 0; i < NSTRS; i++) {
+        strs[i] = PyUnicode_InternFromString(str_values[i]);
+        if (strs[i] == NULL)
+            return NULL;
+    }
+    uint8_descr = PyArray_DescrFromType(NPY_UINT8);
     empty_args = PyTuple_New(0);
-    if (empty_args == NULL)
+    zero = PyFloat_FromDouble(0.0);
+    if (uint8_descr == NULL || empty_args == NULL || zero == NULL)
         return NULL;
     return PyModule_Create(&module);
 }

@@ -28,7 +28,7 @@ from vnrrt.grid import GridError, as_occupancy, as_point
 from vnrrt.planners import core, run
 from vnrrt.planners.collision import segment_free
 from vnrrt.planners.config import PLANNERS, PlannerConfig
-from vnrrt.planners.native import answerer
+from vnrrt.planners.native import answerer, planned
 from vnrrt.planners.reference import reference_length as compute_reference
 from vnrrt.planners.result import PlanResult
 from vnrrt.planners.samplers import Sampler, heatmap_sampler, rng_state, uniform_sampler
@@ -187,10 +187,18 @@ def _free_segment(
     warmup()  # before the timed test: its kernel loaded
     answer = answerer()(occ, sx, sy, gx, gy, target, planner, reference_length, setup_time,
                         fallback)  # fmt: skip
-    if type(answer) is tuple:  # blocked or above the bound: a tree; an endpoint touching
-        bad = answer[0] == core.BAD_ENDPOINT  # an obstacle: _query names it
-        return None, None if bad else ((sx, sy), (gx, gy), answer)
+    if type(answer) is tuple:  # blocked or above the bound: a tree
+        return None, _tested(start, goal, answer)
     return answer, None
+
+
+def _tested(start, goal, tested: tuple[float, float]) -> tuple | None:
+    """:func:`_free_segment`'s ``known`` for points of the common form whose segment was
+    tested (``tested``: :func:`run.straight_test`'s answer) and does not answer."""
+    if tested[0] == core.BAD_ENDPOINT:
+        return None  # an endpoint touching an obstacle: _query names it
+    sx, sy, gx, gy = _floats(start, goal)
+    return (sx, sy), (gx, gy), tested
 
 
 def _seed_ok(seed) -> bool:
@@ -420,16 +428,24 @@ def plan(
     computed); ``seed`` an int >= 0 or a tuple of them. Arguments and errors: :class:`Planner`
     and :meth:`Planner.solve`. Returns a :class:`PlanResult`. RRT* with ``straight_first``
     answers a free straight segment that meets the stop rule without building the
-    :class:`Planner` (the same result, without its setup's microseconds)."""
+    :class:`Planner` (the same result, without its setup's microseconds): in one C call
+    (:data:`vnrrt.planners.native.planned`) when the arguments have the common form."""
+    answer = planned(grid, start, goal, planner, heatmap, config, sampler, stop,
+                     reference_length, seed, milestones, keep_tree)  # fmt: skip
+    if answer is not None and type(answer) is not tuple:  # the common form, answered in C
+        return _logged(answer)
     query = None
     if planner == "rrt_star" and heatmap is None and sampler is None:
         config = _config(config)  # uniform sampling: the free segment needs no Planner
         if config.straight_first:
             grid = _occupancy(grid)
-            answer, known = _free_segment(grid, config, start, goal, stop, reference_length,
-                                          seed, milestones, keep_tree)  # fmt: skip
-            if answer is not None:
-                return _logged(answer)
+            if answer is None:
+                answer, known = _free_segment(grid, config, start, goal, stop, reference_length,
+                                              seed, milestones, keep_tree)  # fmt: skip
+                if answer is not None:
+                    return _logged(answer)
+            else:  # tested in C (blocked, or above the bound): the run reuses the test
+                known = _tested(start, goal, answer)
             query, tested = _query(grid, config, start, goal, stop, reference_length, seed,
                                    milestones, keep_tree, known=known)  # fmt: skip
             answer = run.straight_answer(planner, query, tested)
