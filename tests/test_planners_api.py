@@ -331,13 +331,17 @@ def answers(request, monkeypatch) -> types.SimpleNamespace:
     seen = types.SimpleNamespace(kind=request.param, calls=[])
     monkeypatch.setattr(api, "answerer", lambda: lambda *a: seen.calls.append(a) or real(*a))
 
-    def planned(*args):  # plan()'s common form in C (which tests the segment when it answers
-        answer = native.planned(*args)  # other than None)
-        if answer is not None:
-            seen.calls.append(args)
-        return answer
+    def recorded(fn):  # plan()'s and solve()'s common forms in C (which test the segment
+        def call(*args):  # when they answer other than None)
+            answer = fn(*args)
+            if answer is not None:
+                seen.calls.append(args)
+            return answer
 
-    monkeypatch.setattr(api, "planned", planned if request.param == "c" else native._not_built)
+        return call if request.param == "c" else native._not_built
+
+    monkeypatch.setattr(api, "planned", recorded(native.planned))
+    monkeypatch.setattr(api, "solved", recorded(native.solved))
     return seen
 
 

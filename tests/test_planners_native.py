@@ -13,7 +13,7 @@ import weakref
 import numpy as np
 import pytest
 
-from vnrrt.planners import PlannerConfig, make_sampler, native, plan, run
+from vnrrt.planners import Planner, PlannerConfig, make_sampler, native, plan, run
 from vnrrt.planners.result import FIELDS, PlanResult
 
 TIMES = ("time_to_first", "time_to_stop")
@@ -154,6 +154,7 @@ def test_the_python_answer_is_used_where_the_c_one_is_missing_or_cannot_be_bound
 
     monkeypatch.setattr(api, "answerer", lambda: run.free_answer)
     monkeypatch.setattr(api, "planned", native._not_built)
+    monkeypatch.setattr(api, "solved", native._not_built)
     got = plan(occ, (1.5, 1.5), (17.5, 12.5), config=FASTEST)
     assert (got.cost, got.iterations, got.path.tolist()) == (want.cost, 0, want.path.tolist())
 
@@ -187,8 +188,9 @@ def test_an_unbound_c_answer_raises_and_a_zero_address_is_refused():
         "from vnrrt.planners import _straight as s\n"
         "occ = np.zeros((4, 4), np.uint8)\n"
         "print(s.plan(occ, (1.5, 1.5), (2.5, 2.5), 'rrt_star', *[None] * 5, 0, (), False))\n"
+        "print(s.solve(occ, (1.5, 1.5), (2.5, 2.5), 'initial', None, 0, (), False))\n"
         "for call in (lambda: s.answer(occ, 1.5, 1.5, 2.5, 2.5, None, 'p', None, 0.0, False),\n"
-        "             lambda: s.bind(0, type, {}, type)):\n"
+        "             lambda: s.bind(0, type, {}, type, type)):\n"
         "    try:\n"
         "        call()\n"
         "    except (RuntimeError, ValueError) as e:\n"
@@ -197,6 +199,7 @@ def test_an_unbound_c_answer_raises_and_a_zero_address_is_refused():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.splitlines() == [
         "None",  # plan()'s C answer, unbound: the Python path
+        "None",  # solve()'s
         "RuntimeError answer: no kernel bound (call bind first)",
         "ValueError bind: the kernel address is 0",
     ]
@@ -208,6 +211,10 @@ class Str(str):
 
 class Config(PlannerConfig):
     """A PlannerConfig subclass: not plan()'s common form."""
+
+
+class Sub(Planner):
+    """A Planner subclass: not Planner.solve's common form."""
 
 
 def outcome(fn, *args, **kwargs):
@@ -336,10 +343,50 @@ def test_plans_c_answer_is_its_python_paths(c_answer, monkeypatch):
     assert counts["PlanResult"] > 100 and counts["tuple"] > 60 and counts["none"] > 500, counts
 
 
+def test_solves_c_answer_is_its_python_paths(c_answer, monkeypatch):
+    """Planner.solve with its common form answered in C (native.solved) answers as solve() in
+    Python does (the same result, times apart, or the same error), for planners of every kind
+    (RRT*, a heatmap planner, one whose heatmap has no weight left, a config without
+    straight_first or not validated, a subclass) and random queries of every form."""
+    from vnrrt.planners import api
+
+    rng = np.random.default_rng(6)
+    occ = random_map(rng, 24, 30, 0.04)
+    cfg = PlannerConfig(straight_first=True, max_iterations=40)
+    heat = rng.random(occ.shape)
+    planners = [Planner(occ, config=cfg), Planner(occ, "vnrrt_star", heatmap=heat, config=cfg),
+                Planner(occ, "nrrt_star", heatmap=np.zeros_like(heat), config=cfg),
+                Planner(occ, config=cfg.replace(straight_first=False)), Sub(occ, config=cfg),
+                Planner(occ.astype(bool), config=cfg.replace(eps=0))]  # fmt: skip
+    late = Planner(occ, config=cfg)
+    object.__setattr__(late, "config", cfg.replace(max_iterations=41))  # not validated
+    planners.append(late)
+    kinds = []
+    for _, start, goal, _, kw in plan_arguments(rng, occ, [cfg, cfg], 1200):
+        p = planners[rng.integers(len(planners))]
+        ask = {k: kw[k] for k in ("stop", "reference_length", "seed", "milestones", "keep_tree")}
+        pre = outcome(native.solved, p, start, goal, *ask.values())
+        with monkeypatch.context() as m:
+            m.setattr(api, "solved", native._not_built)
+            python = outcome(p.solve, start, goal, **ask)
+        c = outcome(p.solve, start, goal, **ask)
+        assert_same_outcome(c, python)
+        if type(c) is PlanResult:
+            assert c.setup_time == python.setup_time == p.setup_time
+        kinds.append(type(pre).__name__)
+        if type(pre) is PlanResult:
+            assert_same_outcome(pre, python)
+            assert pre.setup_time == p.setup_time and type(p) is Planner
+        else:
+            assert pre is None or type(pre) is tuple, pre  # never an error
+    counts = {k: kinds.count(k) for k in set(kinds)}
+    assert counts["PlanResult"] > 60 and counts["tuple"] > 30 and counts["NoneType"] > 300, counts
+
+
 def test_plans_c_answer_leaves_nothing_behind(c_answer):
-    """plan()'s C answer (a result, a tested segment's tuple, None for another form) leaves
-    no object behind over repeated calls and the reference counts of its arguments as they
-    were; it refuses a wrong argument count."""
+    """plan()'s and solve()'s C answers (a result, a tested segment's tuple, None for another
+    form) leave no object behind over repeated calls and the reference counts of their
+    arguments as they were; they refuse a wrong argument count."""
     occ = np.zeros((30, 30), np.uint8)
     occ[10:20, 15] = 1
     cfg = PlannerConfig(straight_first=True)
@@ -359,5 +406,19 @@ def test_plans_c_answer_leaves_nothing_behind(c_answer):
     del g, stop, r  # the loop's names
     assert sys.getallocatedblocks() - blocks < 100
     assert [sys.getrefcount(x) for x in watched] == counts
+    p = Planner(occ, "vnrrt_star", heatmap=np.ones((30, 30)), config=cfg)
+    kinds = [type(native.solved(p, start, g, stop, r, 3, (), False)) for g, stop, r in calls]
+    assert kinds == [PlanResult, tuple, tuple, PlanResult, type(None)]
+    watched = (p, p.__dict__, p.sampler, p.planner, p.setup_time, *watched)
+    counts = [sys.getrefcount(x) for x in watched]
+    blocks = sys.getallocatedblocks()
+    for _ in range(3000):
+        for g, stop, r in calls:
+            native.solved(p, start, g, stop, r, 3, (), False)
+    del g, stop, r
+    assert sys.getallocatedblocks() - blocks < 100
+    assert [sys.getrefcount(x) for x in watched] == counts
     with pytest.raises(TypeError, match="12 arguments"):
         native.planned(occ, start, free)
+    with pytest.raises(TypeError, match="8 arguments"):
+        native.solved(p, start, free)

@@ -13,10 +13,18 @@
  *   (d = -1: blocked; -2: an endpoint touches an obstacle or the border). The seconds are the
  *   kernel call's; run.straight_test's also hold numba's dispatch (~0.5 us).
  *
- * bind(kernel_address, result_type, fields)
+ * plan(grid, start, goal, planner, heatmap, config, sampler, stop, reference_length, seed,
+ *      milestones, keep_tree)
+ * solve(planner, start, goal, stop, reference_length, seed, milestones, keep_tree)
+ *   vnrrt.planners.plan's and Planner.solve's arguments in their order (solve's first: the
+ *   Planner): when they have the common form (see plan() and common_query() below) the same
+ *   answer as answer()'s, else None, raising nothing: the caller then checks them in Python.
+ *
+ * bind(kernel_address, result_type, fields, config_type, planner_type)
  *   kernel_address: a numba cfunc's address, double f(const uint8 *, intp h, intp w, double
  *   sx, double sy, double gx, double gy); result_type: the PlanResult class; fields: the
- *   dict of a straight answer's shared fields (run.STRAIGHT), copied per result.
+ *   dict of a straight answer's shared fields (run.STRAIGHT), copied per result;
+ *   config_type, planner_type: the PlannerConfig and Planner classes (of the common form).
  */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
@@ -34,16 +42,17 @@ static PyObject *result_type = NULL; /* PlanResult */
 static PyObject *shared = NULL;      /* the fields every straight answer shares */
 static PyObject *empty_args = NULL;  /* () for object.__new__ */
 static PyObject *config_type = NULL; /* PlannerConfig */
+static PyObject *planner_type = NULL; /* Planner */
 static PyObject *zero = NULL;        /* 0.0: plan()'s setup_time */
 static PyArray_Descr *uint8_descr = NULL; /* numpy's uint8 dtype object */
 
 enum { PLANNER, PATH, COST, FIRST_COST, TIME_TO_FIRST, TIME_TO_STOP, TRACE_ITERATIONS,
        TRACE_COSTS, REFERENCE_LENGTH, TARGET_COST, SETUP_TIME, FALLBACK_UNIFORM, DICT, VALID,
-       STRAIGHT, EPS, NKEYS };
+       STRAIGHT, EPS, OCC, CONFIG, SAMPLER, NKEYS };
 static const char *key_names[NKEYS] = {
     "planner", "path", "cost", "first_cost", "time_to_first", "time_to_stop",
     "trace_iterations", "trace_costs", "reference_length", "target_cost", "setup_time",
-    "fallback_uniform", "__dict__", "_valid", "straight_first", "eps"};
+    "fallback_uniform", "__dict__", "_valid", "straight_first", "eps", "occ", "config", "sampler"};
 static PyObject *keys[NKEYS];
 enum { RRT_STAR, INITIAL, OPTIMAL, NSTRS };
 static const char *str_values[NSTRS] = {"rrt_star", "initial", "optimal"};
@@ -63,9 +72,9 @@ static double seconds(void) {
 
 static PyObject *bind(PyObject *Py_UNUSED(self), PyObject *args) {
     unsigned long long address;
-    PyObject *type, *fields, *config;
-    if (!PyArg_ParseTuple(args, "KO!O!O!:bind", &address, &PyType_Type, &type, &PyDict_Type,
-                          &fields, &PyType_Type, &config))
+    PyObject *type, *fields, *config, *planner;
+    if (!PyArg_ParseTuple(args, "KO!O!O!O!:bind", &address, &PyType_Type, &type, &PyDict_Type,
+                          &fields, &PyType_Type, &config, &PyType_Type, &planner))
         return NULL;
     if (address == 0) {
         PyErr_SetString(PyExc_ValueError, "bind: the kernel address is 0");
@@ -77,6 +86,8 @@ static PyObject *bind(PyObject *Py_UNUSED(self), PyObject *args) {
     Py_XSETREF(shared, fields);
     Py_INCREF(config);
     Py_XSETREF(config_type, config);
+    Py_INCREF(planner);
+    Py_XSETREF(planner_type, planner);
     kernel = (kernel_fn)(uintptr_t)address;
     Py_RETURN_NONE;
 }
@@ -300,45 +311,109 @@ static int config_ok(PyObject *config, double *eps) {
     return ok;
 }
 
+/* A query's common form (api._free_segment's): start and goal points(), stop 'initial' or
+ * 'optimal' with a reference_length float or int, finite and >= 0 (optional for 'initial'),
+ * seed_ok(), milestones () and keep_tree False. q: (start, goal, stop, reference_length, seed,
+ * milestones, keep_tree); eps: the config's. Stores the points in xy and the stop bound in
+ * *target (INFINITY: any length); *optimal: whether the stop rule is 'optimal'. */
+static int common_query(PyObject *const *q, double eps, double *xy, double *target,
+                        int *optimal) {
+    PyObject *stop = q[2], *reference = q[3];
+    double length = 0.0;
+    if (q[6] != Py_False || !PyTuple_CheckExact(q[5]) || PyTuple_GET_SIZE(q[5]) != 0 ||
+        !seed_ok(q[4]) || !points(q[0], q[1], xy))
+        return 0;
+    *optimal = is_str(stop, strs[OPTIMAL]);
+    if (!*optimal && !is_str(stop, strs[INITIAL]))
+        return 0;
+    if (reference != Py_None) {
+        if (PyFloat_CheckExact(reference) == PyLong_CheckExact(reference) ||
+            !number(reference, &length) || !(length >= 0 && length < INFINITY))
+            return 0;
+    } else if (*optimal) {
+        return 0; /* the reference is computed: Python's path */
+    }
+    *target = *optimal ? (1.0 + eps) * length : INFINITY;
+    return 1;
+}
+
+/* The answer of a common query q (common_query()) on occ, given: planner, setup_time and
+ * fallback (borrowed; see straight_result); None when q has another form. */
+static PyObject *common_answer(PyArrayObject *occ, PyObject *const *q, double eps,
+                               PyObject *planner, PyObject *setup_time, PyObject *fallback) {
+    double xy[4], target;
+    int optimal;
+    if (!common_query(q, eps, xy, &target, &optimal))
+        Py_RETURN_NONE;
+    PyObject *given[5] = {optimal ? NULL : Py_None, planner, q[3], setup_time, fallback};
+    return tested(occ, xy, target, given);
+}
+
 /* plan(grid, start, goal, planner, heatmap, config, sampler, stop, reference_length, seed,
  * milestones, keep_tree): its answer when the arguments have plan()'s common form (RRT*, no
- * heatmap or sampler, a validated config with straight_first, the grid used in place, points
- * of two numbers, stop 'initial' or 'optimal' with a float or int reference_length finite
- * and >= 0 (optional for 'initial'), a seed int >= 0 or a tuple of them, milestones (),
- * keep_tree False): the straight answer's PlanResult, or the tuple (d, seconds) of a segment
- * tested that does not answer; None when the arguments have another form or no kernel is
- * bound (plan() then checks them in Python). */
+ * heatmap or sampler, a validated config with straight_first, the grid used in place, a
+ * common query: common_query()): the straight answer's PlanResult, or the tuple (d, seconds)
+ * of a segment tested that does not answer; None when the arguments have another form or no
+ * kernel is bound (plan() then checks them in Python). */
 static PyObject *plan(PyObject *Py_UNUSED(self), PyObject *const *args, Py_ssize_t nargs) {
     if (nargs != 12) {
         PyErr_Format(PyExc_TypeError, "plan takes 12 arguments, got %zd", nargs);
         return NULL;
     }
-    PyObject *grid = args[0], *stop = args[7], *reference = args[8];
-    double xy[4], eps, length = 0.0;
+    double eps;
     if (kernel == NULL || !is_str(args[3], strs[RRT_STAR]) || args[4] != Py_None ||
-        args[6] != Py_None || args[11] != Py_False || !PyTuple_CheckExact(args[10]) ||
-        PyTuple_GET_SIZE(args[10]) != 0 || !seed_ok(args[9]) || !config_ok(args[5], &eps) ||
-        !grid_ok(grid) || !points(args[1], args[2], xy))
+        args[6] != Py_None || !config_ok(args[5], &eps) || !grid_ok(args[0]))
         Py_RETURN_NONE;
-    int optimal = is_str(stop, strs[OPTIMAL]);
-    if (!optimal && !is_str(stop, strs[INITIAL]))
-        Py_RETURN_NONE;
-    if (reference != Py_None) {
-        if (PyFloat_CheckExact(reference) == PyLong_CheckExact(reference) ||
-            !number(reference, &length) || !(length >= 0 && length < INFINITY))
-            Py_RETURN_NONE;
-    } else if (optimal) {
-        Py_RETURN_NONE; /* the reference is computed: Python's path */
+    PyObject *q[7] = {args[1], args[2], args[7], args[8], args[9], args[10], args[11]};
+    return common_answer((PyArrayObject *)args[0], q, eps, strs[RRT_STAR], zero, Py_False);
+}
+
+/* solve(planner, start, goal, stop, reference_length, seed, milestones, keep_tree):
+ * Planner.solve's answer as plan()'s, for a Planner (not a subclass) whose grid is used in
+ * place and whose config is validated with straight_first, its planner name a str, its
+ * setup_time a float and its sampler's fallback_uniform a bool. */
+static PyObject *solve(PyObject *Py_UNUSED(self), PyObject *const *args, Py_ssize_t nargs) {
+    if (nargs != 8) {
+        PyErr_Format(PyExc_TypeError, "solve takes 8 arguments, got %zd", nargs);
+        return NULL;
     }
-    PyObject *given[5] = {optimal ? NULL : Py_None, strs[RRT_STAR], reference, zero, Py_False};
-    return tested((PyArrayObject *)grid, xy, optimal ? (1.0 + eps) * length : INFINITY, given);
+    if (kernel == NULL || !Py_IS_TYPE(args[0], (PyTypeObject *)planner_type))
+        Py_RETURN_NONE;
+    PyObject *dict = PyObject_GenericGetDict(args[0], NULL);
+    if (dict == NULL || !PyDict_CheckExact(dict)) {
+        PyErr_Clear();
+        Py_XDECREF(dict);
+        Py_RETURN_NONE;
+    }
+    static const int names[5] = {OCC, CONFIG, PLANNER, SETUP_TIME, SAMPLER};
+    PyObject *v[5]; /* borrowed from the planner's dict */
+    int found = 1;
+    for (int i = 0; i < 5 && found; i++)
+        found = (v[i] = PyDict_GetItemWithError(dict, keys[names[i]])) != NULL;
+    PyErr_Clear();
+    double eps;
+    PyObject *fallback = NULL, *answer = NULL;
+    if (found && PyUnicode_CheckExact(v[2]) && PyFloat_CheckExact(v[3]) && grid_ok(v[0]) &&
+        config_ok(v[1], &eps)) {
+        fallback = PyObject_GetAttr(v[4], keys[FALLBACK_UNIFORM]);
+        PyErr_Clear();
+    }
+    if (fallback == Py_True || fallback == Py_False)
+        answer = common_answer((PyArrayObject *)v[0], args + 1, eps, v[2], v[3], fallback);
+    Py_XDECREF(fallback);
+    Py_DECREF(dict);
+    if (answer == NULL && !PyErr_Occurred())
+        Py_RETURN_NONE;
+    return answer;
 }
 
 static PyMethodDef methods[] = {
     {"bind", bind, METH_VARARGS,
-     "bind(kernel_address, result_type, fields, config_type): see the module."},
+     "bind(kernel_address, result_type, fields, config_type, planner_type): see the module."},
     {"answer", (PyCFunction)(void (*)(void))answer, METH_FASTCALL,
      "answer(occ, sx, sy, gx, gy, target, planner, reference_length, setup_time, fallback)"},
+    {"solve", (PyCFunction)(void (*)(void))solve, METH_FASTCALL,
+     "solve(planner, start, goal, stop, reference_length, seed, milestones, keep_tree)"},
     {"plan", (PyCFunction)(void (*)(void))plan, METH_FASTCALL,
      "plan(grid, start, goal, planner, heatmap, config, sampler, stop, reference_length, seed, "
      "milestones, keep_tree)"},

@@ -28,7 +28,7 @@ from vnrrt.grid import GridError, as_occupancy, as_point
 from vnrrt.planners import core, run
 from vnrrt.planners.collision import segment_free
 from vnrrt.planners.config import PLANNERS, PlannerConfig
-from vnrrt.planners.native import answerer, planned
+from vnrrt.planners.native import answerer, planned, solved
 from vnrrt.planners.reference import reference_length as compute_reference
 from vnrrt.planners.result import PlanResult
 from vnrrt.planners.samplers import Sampler, heatmap_sampler, rng_state, uniform_sampler
@@ -356,15 +356,20 @@ class Planner:
             NoPathError: the A* reference is needed and start and goal are not connected.
             ValueError: unknown stop rule, bad reference length or seed.
         """
+        ask = (stop, reference_length, seed, milestones, keep_tree)
+        answer = solved(self, start, goal, *ask)  # the common form answered in C, else None
+        if answer is not None and type(answer) is not tuple:
+            return _logged(answer)
         known = None
         if self.config.straight_first:
-            answer, known = _free_segment(self.occ, self.config, start, goal, stop,
-                                          reference_length, seed, milestones, keep_tree,
-                                          self.planner, self.setup_time,
-                                          self.sampler.fallback_uniform)  # fmt: skip
-            if answer is not None:
-                return _logged(answer)
-        ask = (stop, reference_length, seed, milestones, keep_tree)
+            if answer is None:
+                answer, known = _free_segment(self.occ, self.config, start, goal, *ask,
+                                              self.planner, self.setup_time,
+                                              self.sampler.fallback_uniform)  # fmt: skip
+                if answer is not None:
+                    return _logged(answer)
+            else:  # tested in C (blocked, or above the bound): the run reuses the test
+                known = _tested(start, goal, answer)
         query, tested = _query(self.occ, self.config, start, goal, *ask, self.setup_time,
                                self.sampler.fallback_uniform, known)  # fmt: skip
         return self._run(query, seed, tested)

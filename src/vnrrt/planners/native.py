@@ -10,10 +10,11 @@ without numba's dispatch, and the result is built without the interpreter. Its
 (~0.5 us). :func:`built` says which is in use.
 
 :data:`planned` is ``plan()``'s whole call in C for its common form of arguments (RRT*, a
-validated config with ``straight_first``, ...: see its comment): the arguments recognised
-and the answer made without the interpreter (~1 us a call instead of ~2 us; cold, after a
-cache flush, ~17 us instead of ~28 us). Any other form, and any call before :func:`answerer`
-has bound the kernel, gets None: ``plan()`` then checks the arguments in Python, as before.
+validated config with ``straight_first``, ...: see its comment), :data:`solved`
+``Planner.solve``'s: the arguments recognised and the answer made without the interpreter
+(~1 us a call instead of ~2 us; cold, after a cache flush, ~17 us instead of ~28 us). Any
+other form, and any call before :func:`answerer` has bound the kernel, gets None: the caller
+then checks the arguments in Python, as before.
 """
 
 from __future__ import annotations
@@ -46,8 +47,10 @@ def answerer():
         log.info("the C straight answer is not built (%s): using the Python one", error)
         return run.free_answer
     try:
+        from vnrrt.planners.api import Planner  # (api imports this module)
+
         kernel = cfunc(SIGNATURE, cache=True)(core.query_test_at)
-        _straight.bind(kernel.address, PlanResult, run.STRAIGHT, PlannerConfig)
+        _straight.bind(kernel.address, PlanResult, run.STRAIGHT, PlannerConfig, Planner)
     except Exception as error:  # any failure: the Python answer, and a warning
         log.warning("the C straight answer could not be bound (%r): using the Python one", error)
         return run.free_answer
@@ -56,7 +59,7 @@ def answerer():
 
 
 def _not_built(*args) -> None:
-    """:func:`planned` where the extension is not built: never an answer."""
+    """:data:`planned` and :data:`solved` where the extension is not built: never an answer."""
     return None
 
 
@@ -64,10 +67,13 @@ def _not_built(*args) -> None:
 # milestones, keep_tree): plan()'s answer made in C when its arguments have the common form
 # and the C answer is bound (answerer()): the straight answer's PlanResult, or the (d, seconds)
 # of a segment tested that does not answer; else None (plan() then checks them in Python).
+# solved(planner, start, goal, stop, reference_length, seed, milestones, keep_tree): the same
+# for Planner.solve (the Planner first).
 try:
     from vnrrt.planners._straight import plan as planned
+    from vnrrt.planners._straight import solve as solved
 except ImportError:
-    planned = _not_built
+    planned = solved = _not_built
 
 
 def built() -> bool:
