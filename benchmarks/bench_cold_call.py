@@ -4,8 +4,9 @@ does least: the run of a free straight segment, one compiled call (``core.query_
 On each of the development maps whose straight segment is free, the median over ``--calls``
 calls of: a Python function of the same six arguments (the baseline), a trivial compiled
 (numba) function of them, our run's compiled call through numba's dispatch, the C answer
-(:mod:`vnrrt.planners.native`: the same test called through its C address, and the result)
-and the whole ``plan()`` call that uses it; each timed cold (right after ``--flush``
+(:mod:`vnrrt.planners.native`: the same test called through its C address, and the result),
+the whole ``plan()`` call that uses it (its arguments recognised in C) and the ``solve()``
+call of a :class:`vnrrt.planners.Planner` set up once; each timed cold (right after ``--flush``
 MB of a buffer are written and read, as ``bench_planners.py --flush``) and warm (back to back).
 The ratios are to the Python call measured in the same run. It shows where a cold run's time
 goes: the compiled call's dispatch (argument typing, unboxing) against the segment test.
@@ -25,7 +26,7 @@ from numba import njit
 
 from bench_planners import flush_here
 from planner_maps import dev_instances
-from vnrrt.planners import FASTEST, core, plan, segment_free, warmup
+from vnrrt.planners import FASTEST, Planner, core, plan, segment_free, warmup
 from vnrrt.planners.native import answerer, described
 
 
@@ -63,7 +64,7 @@ def main(argv: list[str] | None = None) -> int:
     answer = answerer()
     print(described())  # the 'C answer' column is the Python one where C is not built
     print(f"median us over {args.calls} calls; cold: after a {args.flush:g} MB flush")
-    labels = ("python call", "compiled no-op", "our run", "C answer", "plan() call")
+    labels = ("python call", "compiled no-op", "our run", "C answer", "plan() call", "solve() call")
     print(f"{'map':<10}" + "".join(f"{f + ' cold':>20}{'warm':>7}" for f in labels))
     ratios = {f: [] for f in labels}
     for name, g, s, e in dev_instances():
@@ -72,13 +73,16 @@ def main(argv: list[str] | None = None) -> int:
         if not segment_free(occ, *xy):
             continue
         d = math.hypot(xy[2] - xy[0], xy[3] - xy[1])
-        ask = {"stop": "optimal", "reference_length": d, "seed": 0, "config": FASTEST}
+        query = {"stop": "optimal", "reference_length": d, "seed": 0}
+        ask = {**query, "config": FASTEST}
+        solve = Planner(occ, config=FASTEST).solve  # set up once, as OMPL's setup()
         figures = {
             "python call": (python, (occ, *xy, True)),
             "compiled no-op": (trivial, (occ, *xy, True)),
             "our run": (core.query_test, (occ, *xy, True)),  # through numba's dispatch
             "C answer": (answer, (occ, *xy, 1.01 * d, "rrt_star", d, 0.0, False)),
             "plan() call": (functools.partial(plan, occ, xy[:2], xy[2:], **ask), ()),
+            "solve() call": (functools.partial(solve, xy[:2], xy[2:], **query), ()),
         }
         row = f"{name:<10}"
         base = None
