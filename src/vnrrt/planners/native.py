@@ -12,7 +12,8 @@ without numba's dispatch, and the result is built without the interpreter. Its
 :data:`planned` is ``plan()``'s whole call in C for its common form of arguments (RRT*, a
 validated config with ``straight_first``, ...: see its comment), :data:`solved`
 ``Planner.solve``'s: the arguments recognised and the answer made without the interpreter
-(~1 us a call instead of ~2 us; cold, after a cache flush, ~17 us instead of ~28 us). Any
+(~1 us a call instead of ~2 us; cold, after a 64 MB flush, ~10x a bare Python call's cold
+time instead of ~19x: ``bench_cold_call.py``). Any
 other form, and any call before :func:`answerer` has bound the kernel, gets None: the caller
 then checks the arguments in Python, as before.
 """
