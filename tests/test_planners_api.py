@@ -16,6 +16,7 @@ from vnrrt.planners import (
     PlannerConfigError,
     any_angle_length,
     astar_length,
+    core,
     make_sampler,
     plan,
     polyline_length,
@@ -362,14 +363,16 @@ def answers(request, monkeypatch) -> types.SimpleNamespace:
         ("initial", None, (8, -1), {}, False),  # refused by the general path (a ValueError)
         ("optimal", 5.0, 9, {}, False),  # the segment (5.39 px) above the bound: a search
     ],
-)
+)  # (the last: the common form, checked in C when its answer is in use: _common, not _query)
 def test_a_free_segments_one_pass_answer_is_the_general_paths(
     grid, heat, monkeypatch, answers, stop, reference, seed, extra, fast
 ):
     """The one-pass answer to a free straight segment of plan() and of Planner.solve
     (:func:`api._free_segment`, with the C answer and the Python one) is the general path's
     (the query checked, then the run) field by field, times apart; it is taken for the common
-    form of the arguments only (the general path is not entered then)."""
+    form of the arguments only (the general path is not entered then). With the C answer, the
+    common form whose segment does not answer goes to the run without the general path's
+    checks too (made in C: api._common)."""
     from vnrrt.planners import api
 
     cfg = PlannerConfig(straight_first=True)
@@ -396,7 +399,8 @@ def test_a_free_segments_one_pass_answer_is_the_general_paths(
         if planner == "rrt_star":
             results.append(plan(grid, s, e, config=cfg, **ask))
         monkeypatch.setattr(api, "_query", real)
-        assert len(entered) == (0 if fast else len(results))
+        common = fast or (answers.kind == "c" and (stop, reference) == ("optimal", 5.0))
+        assert len(entered) == (0 if common else len(results))
         assert len(answers.calls) == len(results) or not fast  # the answer function's
         for r in results:
             assert same_run(r, general) and type(r.cost) is type(general.cost)
@@ -464,6 +468,107 @@ def test_one_shot_plans_reuse_a_pooled_tree_and_give_the_same_results(grid, monk
     r = plan(grid, START, GOAL, stop="optimal", reference_length=1.0, seed=0, config=big)
     assert r.tree_size > run.FIRST_CAPACITY  # it grew, so it was not given back
     assert run.POOL.take((run.FIRST_CAPACITY, grid.shape, 5.0, big.trace_capacity)) is None
+
+
+def test_a_one_shot_plan_makes_its_settings_once_per_config_and_shape(grid, monkeypatch):
+    """plan()'s common form that needs a tree (the straight segment blocked, tested in C)
+    runs without a Planner: its settings are made once per config object and map shape and
+    kept for the last SETTINGS_KEPT of them (with the config and sampler whose ids key
+    them), its tree's arrays come from run.POOL and go back; a heatmap sampler's settings
+    are not kept; the results are a Planner's."""
+    from vnrrt.planners import FASTEST, api
+
+    monkeypatch.setattr(api, "SETTINGS", {})
+    made, real = [], api.Settings
+    monkeypatch.setattr(api, "Settings", lambda *a: made.append(a) or real(*a))
+    planners = []
+    init = Planner.__init__
+    monkeypatch.setattr(
+        Planner, "__init__", lambda p, *a, **k: planners.append(1) or init(p, *a, **k)
+    )
+    ask = {"stop": "optimal", "reference_length": 170.0, "seed": 4}
+    cfg = FASTEST.replace(max_iterations=5000)
+    run.POOL.clear()
+    a, b = plan(grid, START, GOAL, config=cfg, **ask), plan(grid, START, GOAL, config=cfg, **ask)
+    assert a.iterations > 0 and (len(made), len(planners)) == (1, 0)  # a tree, no Planner
+    assert run.POOL.take((run.FIRST_CAPACITY, grid.shape, 10.0, cfg.trace_capacity)) is not None
+    solved = Planner(grid, config=cfg).solve(START, GOAL, **ask)
+    for r in (b, solved):
+        assert (r.path.tolist(), r.cost, r.iterations, r.collision_checks) == (
+            a.path.tolist(), a.cost, a.iterations, a.collision_checks)  # fmt: skip
+    plan(grid, START, GOAL, config=cfg.replace(eta=cfg.eta), **ask)  # equal values, new object
+    assert len(made) == 2
+    for k in range(api.SETTINGS_KEPT + 3):
+        plan(grid, START, GOAL, config=cfg.replace(max_iterations=100 + k), **ask)
+    assert len(api.SETTINGS) == api.SETTINGS_KEPT
+    for (cid, sid, shape), (c, smp, _) in api.SETTINGS.items():
+        assert (cid, sid, shape) == (id(c), id(smp), grid.shape)
+    kept = dict(api.SETTINGS)
+    Planner(grid, "vnrrt_star", heatmap=np.ones(grid.shape), config=cfg).solve(START, GOAL, **ask)
+    assert kept == api.SETTINGS  # a heatmap sampler's settings: its Planner's only
+
+
+@pytest.mark.parametrize(
+    "cfg",
+    [
+        PlannerConfig(),
+        PlannerConfig(
+            eta=20.0,
+            informed=True,
+            refine=0.5,
+            pull_parents=True,
+            refine_branches=0.25,
+            gap_share=0.3,
+            gap_width=5,
+            gap_after=7,
+            goal_radius=math.inf,
+            min_spacing=1.5,
+        ),
+        PlannerConfig(radius_mode="fixed", fixed_radius=7.0, eta=math.inf),
+        PlannerConfig(gamma=40.0, gamma_factor=0.5, eta=400.0, goal_radius=12.0),
+    ],
+)
+@pytest.mark.parametrize("planner", ["rrt_star", "vnrrt_star"])
+def test_a_runs_core_settings_are_its_configs_and_its_querys(cfg, planner):
+    """The settings a run hands the core (run.query_params of a Planner's setup) are the
+    config's, the query's start and goal and the map's gamma, each written out here from
+    the definitions (the free area counted cell by cell); the draws are the sampler's and
+    the gap sampler's settings."""
+    rng = np.random.default_rng(3)
+    occ = (rng.random((37, 53)) < 0.2).astype(np.uint8)
+    heat = None if planner == "rrt_star" else rng.random(occ.shape)
+    p = Planner(occ, planner, heatmap=heat, config=cfg)
+    setup = p._ready()
+    free = sum(1 for v in occ.ravel().tolist() if v == 0)
+    base = cfg.gamma if cfg.gamma is not None else 2 * math.sqrt(1.5) * math.sqrt(free / math.pi)
+    want = {
+        "eta": cfg.eta,
+        "gamma": cfg.gamma_factor * base if cfg.radius_mode == "shrinking" else 0.0,
+        "radius": cfg.fixed_radius,
+        "goal_radius": cfg.eta if cfg.goal_radius is None else cfg.goal_radius,
+        "sx": 1.5, "sy": 2.5, "gx": 30.25, "gy": 20.5,
+        "min_spacing": cfg.min_spacing,
+        "bucket": max(min(cfg.eta, 53) / 2, 1.0),
+        "informed": cfg.informed,
+        "refine": cfg.refine,
+        "pull_parents": cfg.pull_parents,
+        "refine_branches": cfg.refine_branches,
+    }  # fmt: skip
+    query = run.Query((1.5, 2.5), (30.25, 20.5), None, (), False, None, 0.0, False)
+    for straight in (False, True):
+        params, first = run.query_params(setup.params, query, straight)
+        got = dict(zip(core.Params._fields, params, strict=True))
+        assert got == pytest.approx(want, rel=1e-15) and got.keys() == want.keys()
+        assert dict(zip(core.Params._fields, first, strict=True)) == pytest.approx(
+            {**want, "goal_radius": math.inf} if straight else want, rel=1e-15)  # fmt: skip
+    d = setup.draws
+    assert setup.flat_draws == tuple(d)
+    s = p.sampler
+    assert (d.mix, d.last) == (s.draw_mix, max(s.last, 0))
+    np.testing.assert_array_equal(d.cdf, s.cdf if s.cdf.size else np.zeros(1))
+    assert (d.gap_share, d.gap_width, d.gap_after) == (cfg.gap_share, cfg.gap_width, cfg.gap_after)
+    assert d.n_gaps == (-1 if cfg.gap_share > 0 else 0)
+    assert setup.work.budget == (cfg.max_iterations, cfg.max_seconds, cfg.trace_capacity)
 
 
 def test_the_tree_pool_is_bounded():

@@ -53,3 +53,37 @@ def test_same_seed_same_result_as_before_the_api_change(cluttered, planner, labe
     config = PlannerConfig(tau=0.9, **SETTINGS[label])
     r = plan(grid, start, goal, planner, heatmap=heat, config=config, stop=stop, seed=(3, 1))
     assert (r.cost, r.iterations, r.tree_size, r.collision_checks) == PINNED[planner, label, stop]
+
+
+# (settings, stop) -> (cost, iterations, tree size, collision checks) of RRT* on the cluttered
+# map with seed (3, 1) and the exact optimum as the reference (267.2472961387225 px), recorded
+# with the code before plan()'s one-shot run without a Planner (commit 0ae509b)
+FASTEST_PINNED = {
+    ("fastest", "initial"): (286.1381321602575, 39, 22, 91),
+    ("fastest", "optimal"): (269.4510754544849, 168, 59, 396),
+    ("fixed", "initial"): (286.1381321602575, 39, 22, 90),
+    ("fixed", "optimal"): (269.8789163686381, 168, 59, 369),
+    ("gamma", "initial"): (286.1381321602575, 39, 22, 91),
+    ("gamma", "optimal"): (269.76942098911024, 213, 101, 469),
+}
+
+
+@pytest.mark.parametrize(("label", "stop"), list(FASTEST_PINNED))
+def test_a_one_shot_plan_and_a_planners_solve_give_the_results_before(cluttered, label, stop):
+    """plan()'s common form (its segment tested in C, the run without a Planner) and a
+    Planner's solve() reproduce the pinned results, with our fastest settings, a fixed radius
+    and a given gamma."""
+    from vnrrt.planners import FASTEST, Planner
+
+    grid, start, goal = cluttered
+    config = {
+        "fastest": FASTEST,
+        "fixed": FASTEST.replace(radius_mode="fixed", fixed_radius=15.0, gap_share=0.0),
+        "gamma": FASTEST.replace(gamma=300.0, gamma_factor=0.5, informed=False),
+    }[label]
+    ask = {"stop": stop, "reference_length": 267.2472961387225, "seed": (3, 1)}
+    for r in (plan(grid, start, goal, config=config, **ask),
+              Planner(grid, config=config).solve(start, goal, **ask)):  # fmt: skip
+        assert (r.cost, r.iterations, r.tree_size, r.collision_checks) == FASTEST_PINNED[
+            label, stop
+        ]

@@ -20,7 +20,9 @@ import functools
 import logging
 import math
 import numbers
+import threading
 import time
+from typing import NamedTuple
 
 import numpy as np
 
@@ -201,6 +203,124 @@ def _tested(start, goal, tested: tuple[float, float]) -> tuple | None:
     return (sx, sy), (gx, gy), tested
 
 
+def _common(cfg: PlannerConfig, start, goal, stop: str, reference_length, tested: tuple,
+            setup_time: float = 0.0, fallback: bool = False) -> run.Query | None:  # fmt: skip
+    """The query of a solve whose arguments :data:`planned` or :data:`solved` recognised in C
+    as the common form (so checked there as :func:`_query` checks them: points of two finite
+    numbers, the stop rule, an int or float reference, the seed, no milestones, no tree kept)
+    and whose straight segment they tested (``tested``: ``(d, seconds)``, the segment blocked
+    or above the stop bound); None when an endpoint touches an obstacle (:func:`_query` then
+    names it). The compiled kernels are loaded (:func:`warmup`), as by :func:`_query`."""
+    if tested[0] == core.BAD_ENDPOINT:
+        return None
+    warmup()
+    sx, sy, gx, gy = _floats(start, goal)
+    target = None if stop == "initial" else (1.0 + cfg.eps) * reference_length
+    return run.Query((sx, sy), (gx, gy), target, (), False, reference_length, setup_time,
+                     fallback)  # fmt: skip
+
+
+class Settings(NamedTuple):
+    """The settings of a config's tree runs with one sampler on maps of one shape, the map's
+    cells apart: the budget, the bucket side (px), the core's settings
+    (:class:`vnrrt.planners.core.Params`, a plain tuple) with the query's start and goal and
+    the map's gamma left at 0 (:func:`_setup` fills the gamma when ``shrinking``), and the
+    sampler as the core reads it (``draws``; ``flat_draws`` the same as a plain tuple)."""
+
+    budget: run.Budget
+    bucket: float
+    params: tuple
+    draws: core.Draws
+    flat_draws: tuple
+    shrinking: bool
+
+
+SETTINGS: dict[tuple, tuple] = {}  # _settings' own: (config, sampler, Settings) by their ids
+SETTINGS_LOCK = threading.Lock()  # held while SETTINGS changes
+SETTINGS_KEPT = 16  # the (config, uniform sampler, shape) whose Settings are kept
+GAMMA = core.Params._fields.index("gamma")
+
+
+def _settings(cfg: PlannerConfig, sampler: Sampler, shape: tuple[int, int]) -> Settings:
+    """:class:`Settings` of ``cfg`` and ``sampler`` on ``(H, W)`` maps. Those of a uniform
+    sampler (plan()'s RRT*, whose sampler is one per shape) are kept for the last
+    :data:`SETTINGS_KEPT` configs and shapes (a one-shot call makes them once, not each time),
+    with the config and the sampler, so that the ids in the key stay theirs."""
+    key = (id(cfg), id(sampler), shape)
+    kept = SETTINGS.get(key)
+    if kept is not None:
+        return kept[2]
+    budget = run.Budget(cfg.max_iterations, cfg.max_seconds, cfg.trace_capacity)
+    bucket = max(min(cfg.eta, max(shape)) / 2, 1.0)  # an unlimited step: the map
+    cdf = sampler.cdf if sampler.cdf.size else np.zeros(1)
+    share = float(cfg.gap_share)  # the gap cells pending (-1) when used: found in the run
+    draws = core.Draws(float(sampler.draw_mix), cdf, max(sampler.last, 0), share,
+                       int(cfg.gap_width), int(cfg.gap_after), core.NO_CELLS,
+                       -1 if share > 0 else 0)  # fmt: skip
+    params = core.Params(
+        eta=float(cfg.eta),
+        gamma=0.0,  # the map's, when shrinking: _setup
+        radius=float(cfg.fixed_radius),
+        goal_radius=float(cfg.eta if cfg.goal_radius is None else cfg.goal_radius),
+        sx=0.0,  # the query's start and goal: run.query_params
+        sy=0.0,
+        gx=0.0,
+        gy=0.0,
+        min_spacing=float(cfg.min_spacing),
+        bucket=bucket,
+        informed=bool(cfg.informed),
+        refine=float(cfg.refine),
+        pull_parents=bool(cfg.pull_parents),
+        refine_branches=float(cfg.refine_branches),
+    )
+    shrinking = cfg.radius_mode == "shrinking"
+    made = Settings(budget, bucket, tuple(params), draws, tuple(draws), shrinking)
+    if sampler.kind == "uniform":
+        with SETTINGS_LOCK:
+            while len(SETTINGS) >= SETTINGS_KEPT:
+                del SETTINGS[next(iter(SETTINGS))]  # the oldest
+            SETTINGS[key] = (cfg, sampler, made)
+    return made
+
+
+def _setup(occ: np.ndarray, cfg: PlannerConfig, sampler: Sampler, pooled: bool) -> run.Setup:
+    """What the tree runs of ``cfg`` with ``sampler`` on ``occ`` share (:class:`run.Setup`):
+    the tree's arrays (taken from :data:`run.POOL` when ``pooled``) and the core's settings,
+    the map's gamma (:func:`_gamma`) in them when the radius shrinks."""
+    made = _settings(cfg, sampler, occ.shape)
+    params = made.params
+    if made.shrinking:
+        params = (*params[:GAMMA], _gamma(occ, cfg), *params[GAMMA + 1 :])
+    work = run.Workspace(occ.shape, made.bucket, made.budget, pooled=pooled)
+    return run.Setup(work, params, made.draws, made.flat_draws)
+
+
+def _gamma(occ: np.ndarray, cfg: PlannerConfig) -> float:
+    """The shrinking-radius constant: ``cfg.gamma_factor`` x (``cfg.gamma``, or the RRT*
+    bound ``2 (1 + 1/d)^(1/d) (free area / unit-ball area)^(1/d)``, d = 2, of the map
+    ``occ``, its free area in cells)."""
+    factor = float(cfg.gamma_factor)
+    if cfg.gamma is not None:
+        return factor * float(cfg.gamma)
+    free = occ.size - np.count_nonzero(occ)
+    return factor * 2.0 * math.sqrt(1.5) * math.sqrt(free / math.pi)
+
+
+def _one_shot(occ: np.ndarray, cfg: PlannerConfig, query: run.Query, seed,
+              tested: tuple[float, float]) -> PlanResult:  # fmt: skip
+    """plan()'s RRT* run of a query of the common form (:func:`_common`: checked in C, its
+    straight segment ``tested`` there, ``(d, seconds)``, not answering it), without a
+    :class:`Planner`: the settings kept per config and shape (:func:`_settings`), the tree's
+    arrays from :data:`run.POOL` and given back. The same run as the Planner's."""
+    setup = _setup(occ, cfg, uniform_sampler(occ.shape), pooled=True)
+    d, spent = tested
+    try:
+        return run.search(occ, query, planner="rrt_star", setup=setup, rng=rng_state(seed),
+                          straight=d >= 0, spent=spent)  # fmt: skip
+    finally:
+        setup.work.release()
+
+
 def _seed_ok(seed) -> bool:
     """Whether ``seed`` is an int >= 0 or a tuple (or list) of them."""
     if type(seed) is int:  # the common cases, checked fast: an int, a tuple of ints
@@ -296,34 +416,19 @@ class Planner:
             check_sampler(sampler, planner, self.occ.shape, self.config)
         self.sampler = sampler
         self._pooled = False  # plan()'s one-shot planner: its tree comes from run.POOL
+        self._setup: run.Setup | None = None  # made by the first tree run (_ready)
 
-    @functools.cached_property
-    def _work(self) -> run.Workspace:
-        """The tree's arrays, reused by every search of this planner (made by the first)."""
-        cfg = self.config
-        budget = run.Budget(cfg.max_iterations, cfg.max_seconds, cfg.trace_capacity)
-        bucket = max(min(cfg.eta, max(self.occ.shape)) / 2, 1.0)  # an unlimited step: the map
-        return run.Workspace(self.occ.shape, bucket, budget, pooled=self._pooled)
-
-    @functools.cached_property
-    def draws(self) -> core.Draws:
-        """The sampler as the core reads it."""
-        s, cfg = self.sampler, self.config
-        cdf = s.cdf if s.cdf.size else np.zeros(1)
-        share = float(cfg.gap_share)  # the gap cells pending (-1) when used: found in the run
-        return core.Draws(float(s.draw_mix), cdf, max(s.last, 0), share, int(cfg.gap_width),
-                          int(cfg.gap_after), core.NO_CELLS, -1 if share > 0 else 0)  # fmt: skip
+    def _ready(self) -> run.Setup:
+        """What this planner's tree runs share (:func:`_setup`), made by the first."""
+        setup = self._setup
+        if setup is None:
+            setup = self._setup = _setup(self.occ, self.config, self.sampler, self._pooled)
+        return setup
 
     @functools.cached_property
     def gamma(self) -> float:
-        """The shrinking-radius constant: ``config.gamma_factor`` x (``config.gamma``, or the
-        RRT* bound ``2 (1 + 1/d)^(1/d) (free area / unit-ball area)^(1/d)``, d = 2, of this
-        map)."""
-        factor = float(self.config.gamma_factor)
-        if self.config.gamma is not None:
-            return factor * float(self.config.gamma)
-        free = self.occ.size - np.count_nonzero(self.occ)
-        return factor * 2.0 * math.sqrt(1.5) * math.sqrt(free / math.pi)
+        """The shrinking-radius constant of this map (:func:`_gamma`)."""
+        return _gamma(self.occ, self.config)
 
     def solve(
         self,
@@ -358,18 +463,20 @@ class Planner:
         """
         ask = (stop, reference_length, seed, milestones, keep_tree)
         answer = solved(self, start, goal, *ask)  # the common form answered in C, else None
-        if answer is not None and type(answer) is not tuple:
-            return _logged(answer)
-        known = None
-        if self.config.straight_first:
-            if answer is None:
-                answer, known = _free_segment(self.occ, self.config, start, goal, *ask,
-                                              self.planner, self.setup_time,
-                                              self.sampler.fallback_uniform)  # fmt: skip
-                if answer is not None:
-                    return _logged(answer)
-            else:  # tested in C (blocked, or above the bound): the run reuses the test
-                known = _tested(start, goal, answer)
+        if answer is not None:
+            if type(answer) is not tuple:
+                return _logged(answer)
+            query = _common(self.config, start, goal, stop, reference_length, answer,
+                            self.setup_time, self.sampler.fallback_uniform)  # fmt: skip
+            if query is not None:  # checked in C and its segment tested: a tree
+                return self._run(query, seed, answer)
+        known = None  # (an endpoint touching an obstacle, found in C: _query names it)
+        if self.config.straight_first and answer is None:
+            answer, known = _free_segment(self.occ, self.config, start, goal, *ask,
+                                          self.planner, self.setup_time,
+                                          self.sampler.fallback_uniform)  # fmt: skip
+            if answer is not None:
+                return _logged(answer)
         query, tested = _query(self.occ, self.config, start, goal, *ask, self.setup_time,
                                self.sampler.fallback_uniform, known)  # fmt: skip
         return self._run(query, seed, tested)
@@ -380,31 +487,9 @@ class Planner:
         result = run.straight_answer(self.planner, query, tested)
         if result is None:
             d, spent = tested
-            result = run.search(self.occ, query, planner=self.planner,
-                                params=self._params(query), draws=self.draws,
-                                rng=rng_state(seed), work=self._work, straight=d >= 0,
-                                spent=spent)  # fmt: skip
+            result = run.search(self.occ, query, planner=self.planner, setup=self._ready(),
+                                rng=rng_state(seed), straight=d >= 0, spent=spent)  # fmt: skip
         return _logged(result)
-
-    def _params(self, query: run.Query) -> core.Params:
-        """The core's settings of a run (:class:`vnrrt.planners.core.Params`)."""
-        cfg = self.config
-        return core.Params(
-            eta=float(cfg.eta),
-            gamma=self.gamma if cfg.radius_mode == "shrinking" else 0.0,
-            radius=float(cfg.fixed_radius),
-            goal_radius=float(cfg.eta if cfg.goal_radius is None else cfg.goal_radius),
-            sx=query.start[0],
-            sy=query.start[1],
-            gx=query.goal[0],
-            gy=query.goal[1],
-            min_spacing=float(cfg.min_spacing),
-            bucket=self._work.bucket,
-            informed=bool(cfg.informed),
-            refine=float(cfg.refine),
-            pull_parents=bool(cfg.pull_parents),
-            refine_branches=float(cfg.refine_branches),
-        )
 
 
 def plan(
@@ -434,11 +519,18 @@ def plan(
     and :meth:`Planner.solve`. Returns a :class:`PlanResult`. RRT* with ``straight_first``
     answers a free straight segment that meets the stop rule without building the
     :class:`Planner` (the same result, without its setup's microseconds): in one C call
-    (:data:`vnrrt.planners.native.planned`) when the arguments have the common form."""
+    (:data:`vnrrt.planners.native.planned`) when the arguments have the common form. When
+    that form's segment does not answer, the tree's run is made without a :class:`Planner`
+    too (:func:`_one_shot`: the settings kept per config and map shape, the tree's arrays
+    from a pool; the same result as a Planner's, ``setup_time`` 0: no sampler is built)."""
     answer = planned(grid, start, goal, planner, heatmap, config, sampler, stop,
                      reference_length, seed, milestones, keep_tree)  # fmt: skip
     if answer is not None and type(answer) is not tuple:  # the common form, answered in C
         return _logged(answer)
+    if answer is not None:  # the common form, checked in C and its segment tested: a tree
+        query = _common(config, start, goal, stop, reference_length, answer)
+        if query is not None:  # (None: an endpoint touches an obstacle, named below)
+            return _logged(_one_shot(grid, config, query, seed, answer))
     query = None
     if planner == "rrt_star" and heatmap is None and sampler is None:
         config = _config(config)  # uniform sampling: the free segment needs no Planner
@@ -449,8 +541,8 @@ def plan(
                                               seed, milestones, keep_tree)  # fmt: skip
                 if answer is not None:
                     return _logged(answer)
-            else:  # tested in C (blocked, or above the bound): the run reuses the test
-                known = _tested(start, goal, answer)
+            else:  # an endpoint touching an obstacle, found in C: _query names it
+                known = None
             query, tested = _query(grid, config, start, goal, stop, reference_length, seed,
                                    milestones, keep_tree, known=known)  # fmt: skip
             answer = run.straight_answer(planner, query, tested)
@@ -464,8 +556,8 @@ def plan(
                            milestones=milestones, keep_tree=keep_tree)  # fmt: skip
         return p._run(query._replace(setup_time=p.setup_time), seed, tested)
     finally:
-        if "_work" in p.__dict__:  # a tree was made (not for a free straight segment)
-            p._work.release()
+        if p._setup is not None:  # a tree was made (not for a free straight segment)
+            p._setup.work.release()
 
 
 @functools.cache

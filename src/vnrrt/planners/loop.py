@@ -16,6 +16,7 @@ passed, not after Python has taken over.
 
 from __future__ import annotations
 
+import numpy as np
 from numba import njit
 
 from vnrrt.planners.clock import monotonic
@@ -29,7 +30,7 @@ from vnrrt.planners.core import (
     plant,
     with_gaps,
 )
-from vnrrt.planners.tree import Counters, Scratch, Trace, Tree
+from vnrrt.planners.tree import Counters, Scratch, Trace, Tree, finish
 
 FIRST_CHUNK, MAX_CHUNK = 64, 4096  # iterations per chunk; budgets checked between
 SOLVED, MAX_ITERATIONS, MAX_SECONDS = 3, 4, 5  # return codes of :func:`drive` (or TREE_FULL)
@@ -82,3 +83,21 @@ def drive_flat(occ, tree, scratch, counters, trace, rng, draws, stops, p, first,
     return drive(occ, Tree(*tree), Scratch(*scratch), Counters(*counters), Trace(*trace), rng,
                  Draws(*draws), stops, Params(*p), Params(*first), budget, state, times,
                  iters)  # fmt: skip
+
+
+@njit(cache=True)
+def run_flat(occ, tree, scratch, counters, trace, rng, draws, stops, p, first, budget, state,
+             times, iters):  # fmt: skip
+    """:func:`drive_flat`, then, when the run is over, its result's arrays made in the same
+    compiled call (:func:`vnrrt.planners.tree.finish`: path, segment lengths, trace
+    iterations and costs): ``(code, path, segs, trace_iters, trace_costs)``, the arrays empty
+    when the code is :data:`~vnrrt.planners.core.TREE_FULL` (the caller then enlarges the
+    tree and calls again)."""
+    code = drive_flat(occ, tree, scratch, counters, trace, rng, draws, stops, p, first, budget,
+                      state, times, iters)  # fmt: skip
+    if code == TREE_FULL:
+        return code, np.zeros((0, 2)), np.zeros(0), np.zeros(0, np.int64), np.zeros(0)
+    t, c, tr = Tree(*tree), Counters(*counters), Trace(*trace)
+    path, segs, trace_iters, trace_costs = finish(t.links, t.pts, t.cost, c.goal[0], tr.iters,
+                                                  tr.costs, c.trace_len[0], c.iters[0])  # fmt: skip
+    return code, path, segs, trace_iters, trace_costs

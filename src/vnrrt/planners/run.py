@@ -159,7 +159,10 @@ POOL = TreePool()
 def stop_bounds(query: Query) -> np.ndarray:
     """The cost bounds the core reports passing, decreasing: ``inf`` (any solution), the
     extra bounds and the stop bound."""
-    wanted = {math.inf, *query.bounds, *([] if query.target is None else [query.target])}
+    target = query.target
+    if not query.bounds:  # the common case, without the set and the sort
+        return np.array((math.inf,) if target is None or target == math.inf else (math.inf, target))
+    wanted = {math.inf, *query.bounds, *([] if target is None else [target])}
     return np.array(sorted(wanted, reverse=True))
 
 
@@ -280,31 +283,59 @@ STRAIGHT = {
 ROOT_TRACE = np.zeros(1, np.int64)  # a straight answer's trace iterations (copied per result)
 
 
+class Setup(NamedTuple):
+    """What every tree run of one :class:`vnrrt.planners.Planner` shares, made once before
+    its first run (as OMPL's ``setup()``): the tree's arrays (``work``), the core's settings
+    (:class:`vnrrt.planners.core.Params`) as a plain tuple whose query fields ``sx, sy, gx,
+    gy`` are placeholders (:func:`query_params` fills them), and the sampler as the core
+    reads it (``draws``, and ``flat_draws``: the same as a plain tuple, what the compiled
+    loop takes)."""
+
+    work: Workspace
+    params: tuple
+    draws: core.Draws
+    flat_draws: tuple
+
+
+SX = core.Params._fields.index("sx")  # sx, sy, gx, gy follow in this order: the query's
+GOAL_RADIUS = core.Params._fields.index("goal_radius")
+assert core.Params._fields[SX : SX + 4] == ("sx", "sy", "gx", "gy")
+
+
+def query_params(params: tuple, query: Query, straight: bool) -> tuple[tuple, tuple]:
+    """The core's settings of a run (``params``: :attr:`Setup.params`) with the query's
+    start and goal, and those of planting (``first``): the same, with any node joining the
+    goal when the straight segment is known to be free (``straight``). Plain tuples in
+    :class:`vnrrt.planners.core.Params`' order."""
+    p = params[:SX] + query.start + query.goal + params[SX + 4 :]
+    first = (*p[:GOAL_RADIUS], math.inf, *p[GOAL_RADIUS + 1 :]) if straight else p
+    return p, first
+
+
 def search(
     occ: np.ndarray,
     query: Query,
     *,
     planner: str,
-    params: core.Params,
-    draws: core.Draws,
+    setup: Setup,
     rng: np.ndarray,
-    work: Workspace,
     straight: bool,
     spent: float = 0.0,
 ) -> PlanResult:
-    """Grow a tree (in ``work``) from the start until the stop rule or a budget is met;
+    """Grow a tree (in ``setup.work``) from the start until the stop rule or a budget is met;
     ``straight``: the start-goal segment is known to be free (the goal joins the root at
     once); ``spent``: seconds of the run before this call (the straight-segment test)."""
     stops = stop_bounds(query)
-    run = work.fresh()  # allocated (or emptied) before the clock starts, as OMPL's setup()
-    first = tuple(params._replace(goal_radius=math.inf) if straight else params)
+    run = setup.work.fresh()  # allocated (or emptied) before the clock starts, as OMPL's setup()
+    params, first = query_params(setup.params, query, straight)
     drive = drive_compiled if clock.IN_KERNEL else drive_python
     t0 = time.perf_counter() - spent
-    job = Job(draws, params, first, rng, stops, query.target, work.budget, t0)
-    reason, times, iters = drive(run, occ, job)
+    job = Job(setup, params, first, rng, stops, query.target, t0)
+    reason, times, iters, finished = drive(run, occ, job)
     elapsed = time.perf_counter() - t0
     reached = dict(zip(stops.tolist(), zip(times.tolist(), iters.tolist()), strict=True))
-    return result(run, planner, query, reason=reason, reached=reached, elapsed=elapsed)
+    return result(run, planner, query, reason=reason, reached=reached, elapsed=elapsed,
+                  finished=finished)  # fmt: skip
 
 
 REASONS = {loop.SOLVED: "solved", loop.MAX_ITERATIONS: "max_iterations",
@@ -312,35 +343,46 @@ REASONS = {loop.SOLVED: "solved", loop.MAX_ITERATIONS: "max_iterations",
 
 
 class Job(NamedTuple):
-    """What a run's loop reads besides the tree and the grid: the sampler, the run's
-    settings (``first``: those of planting, a plain tuple), the rng state, the stop bounds
-    (decreasing), the stop bound to meet (None: the first solution), the budgets and the
-    run's start ``t0`` (``time.perf_counter`` seconds)."""
+    """What a run's loop reads besides the tree and the grid: the planner's :class:`Setup`
+    (its sampler and budgets), the run's settings (``params``; ``first``: those of planting;
+    plain tuples in :class:`vnrrt.planners.core.Params`' order), the rng state, the stop
+    bounds (decreasing), the stop bound to meet (None: the first solution) and the run's
+    start ``t0`` (``time.perf_counter`` seconds)."""
 
-    draws: core.Draws
-    params: core.Params
+    setup: Setup
+    params: tuple
     first: tuple
     rng: np.ndarray
     stops: np.ndarray
     target: float | None
-    budget: Budget
     t0: float
 
 
-def drive_compiled(run: Tree, occ: np.ndarray, job: Job) -> tuple[str, np.ndarray, np.ndarray]:
-    """:func:`drive_python` in one compiled call (:func:`vnrrt.planners.loop.drive`), back in
-    Python only to enlarge a full tree; the same tree, iterations and costs."""
-    m, budget = len(job.stops), job.budget
-    times, iters = np.full(m, np.nan), np.full(m, -1, np.int64)
+def drive_compiled(
+    run: Tree, occ: np.ndarray, job: Job
+) -> tuple[str, np.ndarray, np.ndarray, tuple]:
+    """:func:`drive_python` in one compiled call (:func:`vnrrt.planners.loop.run_flat`, the
+    result's arrays made in it), back in Python only to enlarge a full tree; the same tree,
+    iterations, costs and arrays."""
+    (times, iters), budget = unreached(len(job.stops)), job.setup.work.budget
     state = np.array([FIRST_CHUNK, 0, 1], np.int64)  # chunk, bounds passed, plant
     target = math.inf if job.target is None else float(job.target)
     limits = (target, int(budget.max_iterations), float(budget.max_seconds), job.t0)
-    rest = (tuple(job.draws), job.stops, tuple(job.params), job.first, limits, state, times, iters)
+    rest = (job.setup.flat_draws, job.stops, job.params, job.first, limits, state, times, iters)
     while True:  # after a full tree, the gap cells found in the call are found again (same)
-        code = loop.drive_flat(occ, *run.flat, job.rng, *rest)
-        if code != core.TREE_FULL:
-            return REASONS[code], times, iters
+        out = loop.run_flat(occ, *run.flat, job.rng, *rest)
+        if out[0] != core.TREE_FULL:
+            return REASONS[out[0]], times, iters, out[1:]
         make_room(run, budget)
+
+
+def unreached(m: int) -> tuple[np.ndarray, np.ndarray]:
+    """The times (s, float64, NaN) and iterations (int64, -1) at which ``m`` stop bounds
+    were first passed, before a run."""
+    times, iters = np.empty(m), np.empty(m, np.int64)
+    times.fill(math.nan)
+    iters.fill(-1)
+    return times, iters
 
 
 def make_room(run: Tree, budget: Budget) -> None:
@@ -350,22 +392,37 @@ def make_room(run: Tree, budget: Budget) -> None:
     run.enlarge(min(2 * run.capacity, budget.max_iterations + 2))
 
 
-def drive_python(run: Tree, occ: np.ndarray, job: Job) -> tuple[str, np.ndarray, np.ndarray]:
+def drive_python(run: Tree, occ: np.ndarray, job: Job) -> tuple[str, np.ndarray, np.ndarray, tuple]:
     """Plant the tree and grow it in compiled chunks until the stop rule or a budget is met,
     timing it in Python (where :data:`vnrrt.planners.clock.IN_KERNEL` is False).
 
-    Returns ``(stop_reason, times, iterations)``: per entry of ``stops`` (decreasing cost
-    bounds), the time (s since ``t0``, ``time.perf_counter``) and iteration at which it was
-    first reached (NaN / -1: never), float64 and int64 as :func:`drive_compiled` returns them.
-    """
+    Returns ``(stop_reason, times, iterations, finished)``: per entry of ``stops``
+    (decreasing cost bounds), the time (s since ``t0``, ``time.perf_counter``) and iteration
+    at which it was first reached (NaN / -1: never), float64 and int64 as
+    :func:`drive_compiled` returns them; ``finished``: the result's arrays
+    (:func:`finished`)."""
+    reason, times, iters = grow_python(run, occ, job)
+    return reason, times, iters, finished(run)
+
+
+def finished(run: Tree) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """A finished run's path, segment lengths, trace iterations and costs
+    (:func:`vnrrt.planners.tree.finish`)."""
+    c, tree, trace = run.counters, run.tree, run.trace
+    return nodes.finish(tree.links, tree.pts, tree.cost, int(c.goal[0]), trace.iters,
+                        trace.costs, int(c.trace_len[0]), int(c.iters[0]))  # fmt: skip
+
+
+def grow_python(run: Tree, occ: np.ndarray, job: Job) -> tuple[str, np.ndarray, np.ndarray]:
+    """:func:`drive_python`'s loop: its first three returns."""
     tree, _, c, trace = run.flat
-    stops, budget = job.stops, job.budget
+    stops, budget = job.stops, job.setup.work.budget
     core.plant_flat(occ, tree, c, run.scratch.stack, trace, job.first, stops)
     c = run.counters
-    times, iters = np.full(len(stops), np.nan), np.full(len(stops), -1, np.int64)
+    times, iters = unreached(len(stops))
     chunk, passed, status = FIRST_CHUNK, 0, core.RUNNING
-    draws, params_t = job.draws, tuple(job.params)
-    draws_t = tuple(draws)
+    draws, params_t = job.setup.draws, job.params
+    draws_t = job.setup.flat_draws
     while True:
         now = time.perf_counter() - job.t0
         for m in range(passed, int(c.milestone[0])):
@@ -396,13 +453,13 @@ def result(
     reason: str,
     reached: dict[float, tuple[float, int]],
     elapsed: float,
+    finished: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray],
 ) -> PlanResult:
-    """The :class:`PlanResult` of a finished run; ``reached[bound] = (seconds, iteration)``."""
-    c, tree, trace = run.counters, run.tree, run.trace
+    """The :class:`PlanResult` of a finished run; ``reached[bound] = (seconds, iteration)``;
+    ``finished``: its path, segment lengths, trace iterations and costs (:func:`finished`)."""
+    c, tree = run.counters, run.tree
     n, g, k = int(c.nodes[0]), int(c.goal[0]), int(c.trace_len[0])
-    path, segs, trace_it, trace_cost = nodes.finish(
-        tree.links, tree.pts, tree.cost, g, trace.iters, trace.costs, k, int(c.iters[0])
-    )
+    path, segs, trace_it, trace_cost = finished
     first_time, first_iter = reached[math.inf]
     return made({
         "planner": planner,
