@@ -473,14 +473,14 @@ def test_one_shot_plans_reuse_a_pooled_tree_and_give_the_same_results(grid, monk
 def test_a_one_shot_plan_makes_its_settings_once_per_config_and_shape(grid, monkeypatch):
     """plan()'s common form that needs a tree (the straight segment blocked, tested in C)
     runs without a Planner: its settings are made once per config object and map shape and
-    kept for the last SETTINGS_KEPT of them (with the config and sampler whose ids key
+    kept for the last settings.KEEP of them (with the config and sampler whose ids key
     them), its tree's arrays come from run.POOL and go back; a heatmap sampler's settings
     are not kept; the results are a Planner's."""
-    from vnrrt.planners import FASTEST, api
+    from vnrrt.planners import FASTEST, settings
 
-    monkeypatch.setattr(api, "SETTINGS", {})
-    made, real = [], api.Settings
-    monkeypatch.setattr(api, "Settings", lambda *a: made.append(a) or real(*a))
+    monkeypatch.setattr(settings, "KEPT", {})
+    made, real = [], settings.Settings
+    monkeypatch.setattr(settings, "Settings", lambda *a: made.append(a) or real(*a))
     planners = []
     init = Planner.__init__
     monkeypatch.setattr(
@@ -498,14 +498,14 @@ def test_a_one_shot_plan_makes_its_settings_once_per_config_and_shape(grid, monk
             a.path.tolist(), a.cost, a.iterations, a.collision_checks)  # fmt: skip
     plan(grid, START, GOAL, config=cfg.replace(eta=cfg.eta), **ask)  # equal values, new object
     assert len(made) == 2
-    for k in range(api.SETTINGS_KEPT + 3):
+    for k in range(settings.KEEP + 3):
         plan(grid, START, GOAL, config=cfg.replace(max_iterations=100 + k), **ask)
-    assert len(api.SETTINGS) == api.SETTINGS_KEPT
-    for (cid, sid, shape), (c, smp, _) in api.SETTINGS.items():
+    assert len(settings.KEPT) == settings.KEEP
+    for (cid, sid, shape), (c, smp, _) in settings.KEPT.items():
         assert (cid, sid, shape) == (id(c), id(smp), grid.shape)
-    kept = dict(api.SETTINGS)
+    kept = dict(settings.KEPT)
     Planner(grid, "vnrrt_star", heatmap=np.ones(grid.shape), config=cfg).solve(START, GOAL, **ask)
-    assert kept == api.SETTINGS  # a heatmap sampler's settings: its Planner's only
+    assert kept == settings.KEPT  # a heatmap sampler's settings: its Planner's only
 
 
 @pytest.mark.parametrize(

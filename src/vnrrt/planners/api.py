@@ -20,14 +20,12 @@ import functools
 import logging
 import math
 import numbers
-import threading
 import time
-from typing import NamedTuple
 
 import numpy as np
 
 from vnrrt.grid import GridError, as_occupancy, as_point
-from vnrrt.planners import core, run
+from vnrrt.planners import core, run, settings
 from vnrrt.planners.collision import segment_free
 from vnrrt.planners.config import PLANNERS, PlannerConfig
 from vnrrt.planners.native import answerer, planned, solved
@@ -220,99 +218,13 @@ def _common(cfg: PlannerConfig, start, goal, stop: str, reference_length, tested
                      fallback)  # fmt: skip
 
 
-class Settings(NamedTuple):
-    """The settings of a config's tree runs with one sampler on maps of one shape, the map's
-    cells apart: the budget, the bucket side (px), the core's settings
-    (:class:`vnrrt.planners.core.Params`, a plain tuple) with the query's start and goal and
-    the map's gamma left at 0 (:func:`_setup` fills the gamma when ``shrinking``), and the
-    sampler as the core reads it (``draws``; ``flat_draws`` the same as a plain tuple)."""
-
-    budget: run.Budget
-    bucket: float
-    params: tuple
-    draws: core.Draws
-    flat_draws: tuple
-    shrinking: bool
-
-
-SETTINGS: dict[tuple, tuple] = {}  # _settings' own: (config, sampler, Settings) by their ids
-SETTINGS_LOCK = threading.Lock()  # held while SETTINGS changes
-SETTINGS_KEPT = 16  # the (config, uniform sampler, shape) whose Settings are kept
-GAMMA = core.Params._fields.index("gamma")
-
-
-def _settings(cfg: PlannerConfig, sampler: Sampler, shape: tuple[int, int]) -> Settings:
-    """:class:`Settings` of ``cfg`` and ``sampler`` on ``(H, W)`` maps. Those of a uniform
-    sampler (plan()'s RRT*, whose sampler is one per shape) are kept for the last
-    :data:`SETTINGS_KEPT` configs and shapes (a one-shot call makes them once, not each time),
-    with the config and the sampler, so that the ids in the key stay theirs."""
-    key = (id(cfg), id(sampler), shape)
-    kept = SETTINGS.get(key)
-    if kept is not None:
-        return kept[2]
-    budget = run.Budget(cfg.max_iterations, cfg.max_seconds, cfg.trace_capacity)
-    bucket = max(min(cfg.eta, max(shape)) / 2, 1.0)  # an unlimited step: the map
-    cdf = sampler.cdf if sampler.cdf.size else np.zeros(1)
-    share = float(cfg.gap_share)  # the gap cells pending (-1) when used: found in the run
-    draws = core.Draws(float(sampler.draw_mix), cdf, max(sampler.last, 0), share,
-                       int(cfg.gap_width), int(cfg.gap_after), core.NO_CELLS,
-                       -1 if share > 0 else 0)  # fmt: skip
-    params = core.Params(
-        eta=float(cfg.eta),
-        gamma=0.0,  # the map's, when shrinking: _setup
-        radius=float(cfg.fixed_radius),
-        goal_radius=float(cfg.eta if cfg.goal_radius is None else cfg.goal_radius),
-        sx=0.0,  # the query's start and goal: run.query_params
-        sy=0.0,
-        gx=0.0,
-        gy=0.0,
-        min_spacing=float(cfg.min_spacing),
-        bucket=bucket,
-        informed=bool(cfg.informed),
-        refine=float(cfg.refine),
-        pull_parents=bool(cfg.pull_parents),
-        refine_branches=float(cfg.refine_branches),
-    )
-    shrinking = cfg.radius_mode == "shrinking"
-    made = Settings(budget, bucket, tuple(params), draws, tuple(draws), shrinking)
-    if sampler.kind == "uniform":
-        with SETTINGS_LOCK:
-            while len(SETTINGS) >= SETTINGS_KEPT:
-                del SETTINGS[next(iter(SETTINGS))]  # the oldest
-            SETTINGS[key] = (cfg, sampler, made)
-    return made
-
-
-def _setup(occ: np.ndarray, cfg: PlannerConfig, sampler: Sampler, pooled: bool) -> run.Setup:
-    """What the tree runs of ``cfg`` with ``sampler`` on ``occ`` share (:class:`run.Setup`):
-    the tree's arrays (taken from :data:`run.POOL` when ``pooled``) and the core's settings,
-    the map's gamma (:func:`_gamma`) in them when the radius shrinks."""
-    made = _settings(cfg, sampler, occ.shape)
-    params = made.params
-    if made.shrinking:
-        params = (*params[:GAMMA], _gamma(occ, cfg), *params[GAMMA + 1 :])
-    work = run.Workspace(occ.shape, made.bucket, made.budget, pooled=pooled)
-    return run.Setup(work, params, made.draws, made.flat_draws)
-
-
-def _gamma(occ: np.ndarray, cfg: PlannerConfig) -> float:
-    """The shrinking-radius constant: ``cfg.gamma_factor`` x (``cfg.gamma``, or the RRT*
-    bound ``2 (1 + 1/d)^(1/d) (free area / unit-ball area)^(1/d)``, d = 2, of the map
-    ``occ``, its free area in cells)."""
-    factor = float(cfg.gamma_factor)
-    if cfg.gamma is not None:
-        return factor * float(cfg.gamma)
-    free = occ.size - np.count_nonzero(occ)
-    return factor * 2.0 * math.sqrt(1.5) * math.sqrt(free / math.pi)
-
-
 def _one_shot(occ: np.ndarray, cfg: PlannerConfig, query: run.Query, seed,
               tested: tuple[float, float]) -> PlanResult:  # fmt: skip
     """plan()'s RRT* run of a query of the common form (:func:`_common`: checked in C, its
     straight segment ``tested`` there, ``(d, seconds)``, not answering it), without a
-    :class:`Planner`: the settings kept per config and shape (:func:`_settings`), the tree's
+    :class:`Planner`: the settings kept per config and shape (:func:`.settings.of`), the tree's
     arrays from :data:`run.POOL` and given back. The same run as the Planner's."""
-    setup = _setup(occ, cfg, uniform_sampler(occ.shape), pooled=True)
+    setup = settings.setup(occ, cfg, uniform_sampler(occ.shape), pooled=True)
     d, spent = tested
     try:
         return run.search(occ, query, planner="rrt_star", setup=setup, rng=rng_state(seed),
@@ -419,16 +331,18 @@ class Planner:
         self._setup: run.Setup | None = None  # made by the first tree run (_ready)
 
     def _ready(self) -> run.Setup:
-        """What this planner's tree runs share (:func:`_setup`), made by the first."""
+        """What this planner's tree runs share (:func:`.settings.setup`), made by the
+        first."""
         setup = self._setup
         if setup is None:
-            setup = self._setup = _setup(self.occ, self.config, self.sampler, self._pooled)
+            setup = self._setup = settings.setup(self.occ, self.config, self.sampler,
+                                                 self._pooled)  # fmt: skip
         return setup
 
     @functools.cached_property
     def gamma(self) -> float:
-        """The shrinking-radius constant of this map (:func:`_gamma`)."""
-        return _gamma(self.occ, self.config)
+        """The shrinking-radius constant of this map (:func:`.settings.gamma`)."""
+        return settings.gamma(self.occ, self.config)
 
     def solve(
         self,
