@@ -5,10 +5,10 @@ Coordinates follow :mod:`vnrrt.grid`: ``grid`` is ``(H, W)`` indexed ``grid[y, x
 (nonzero = obstacle), start and goal are continuous ``(x, y)`` pixel points (cell
 centres ``(x + 0.5, y + 0.5)`` for dataset instances). Every setting comes from one
 :class:`PlannerConfig` (the M-VNRRT* threshold ``tau`` included). Timings cover the tree
-search only: building the sampler from a heatmap (per map, once; reported as
-``setup_time``), allocating the tree's arrays (per planner, reused; as OMPL's ``setup()``),
-seeding, JIT compilation (once per process, :func:`warmup`) and the reference-length
-computation (an oracle, not part of planning) are outside the timed region. With
+search and taking its path out (:mod:`.run`): building the sampler from a heatmap (per map,
+once; reported as ``setup_time``), allocating the tree's arrays (per planner, reused; as
+OMPL's ``setup()``), seeding, JIT compilation (once per process, :func:`warmup`) and the
+reference-length computation (an oracle, not part of planning) are outside the timed region. With
 ``straight_first``, a free start-goal segment that meets the stop rule is the answer: the run's
 time is that one segment test (:mod:`.run`). The gap sampler's cells (``gap_share``) are found
 inside the run, after ``gap_after`` iterations.

@@ -1,15 +1,17 @@
 """One planner run on validated inputs: the timed region of :meth:`vnrrt.planners.Planner.solve`.
 
 The clock starts before the straight start-goal segment is tested (when ``straight_first``) and
-stops when the stop rule or a budget is met. The tree's arrays are allocated (or emptied for
-reuse) before it starts, as OMPL's ``setup()`` is outside its ``solve()`` times; growing them is
-inside. A free straight segment that meets the stop rule is the exact optimum, known after that
-one segment test: its result (a two-node tree) is written after the clock has stopped, like
-every result (:func:`free_answer`; :mod:`.native` makes the same answer in one C call).
-Otherwise the tree grows in compiled chunks of :func:`vnrrt.planners.core.grow`, budgets
-checked between chunks: all in one compiled call on 64-bit Linux (:func:`drive_compiled`,
-:mod:`.loop`), else returning to Python after each chunk (:func:`drive_python`); both grow the
-same tree. A one-shot :func:`vnrrt.planners.plan` takes its tree's arrays from :data:`POOL`."""
+stops when the stop rule or a budget is met and a grown tree's path and trace are taken out of
+it (:func:`finished`, in the same compiled call: as OMPL's ``solve()`` builds its solution
+path). The tree's arrays are allocated (or emptied for reuse) before it starts, as OMPL's
+``setup()`` is outside its ``solve()`` times; growing them is inside. A free straight segment
+that meets the stop rule is the exact optimum, known after that one segment test: its result
+(a two-node tree) is written after the clock has stopped, as every result object is
+(:func:`free_answer`; :mod:`.native` makes the same answer in one C call). Otherwise the tree
+grows in compiled chunks of :func:`vnrrt.planners.core.grow`, budgets checked between chunks:
+all in one compiled call on 64-bit Linux (:func:`drive_compiled`, :mod:`.loop`), else
+returning to Python after each chunk (:func:`drive_python`); both grow the same tree. A
+one-shot :func:`vnrrt.planners.plan` takes its tree's arrays from :data:`POOL`."""
 
 from __future__ import annotations
 
