@@ -19,45 +19,33 @@ from __future__ import annotations
 import argparse
 import gc
 import sys
-import time
 
 import numpy as np
 
 import ompl_native
+from bench_planners import run_ours
 from planner_maps import dev_instances, held_out_instances
-from vnrrt.planners import FASTEST, PlannerConfig, any_angle_path, plan, warmup
+from vnrrt.planners import FASTEST, PlannerConfig, any_angle_path, warmup
 
 MAPS = "open,random1,random11,random_h1,random_h6"
 NATIVE = ("RRTstar", "InformedRRTstar", "BITstar", "ABITstar")
 WARM = 0.001  # seconds of each untimed run, as bench_planners' --warm
 
 
-def ours(g, s, e, exact: float, config: PlannerConfig, seed) -> tuple[float, float]:
-    """One plan() to 1% of ``exact``, the collector off: (whole call, run) in seconds."""
-    gc.disable()
-    try:
-        t0 = time.perf_counter()
-        r = plan(g, s, e, stop="optimal", reference_length=exact, seed=seed, config=config)
-        call = time.perf_counter() - t0
-    finally:
-        gc.enable()
-    return call, r.time_to_stop
-
-
 def trial(native, g, s, e, exact: float, k: int, limit: float) -> tuple[float, float]:
-    """bench_planners' trial ``k`` on one map (ours, then native OMPL's); our timed call's
-    (whole call, run)."""
+    """bench_planners' trial ``k`` on one map (ours, then native OMPL's; our calls timed by
+    its :func:`bench_planners.run_ours`); our timed call's (whole call, run) in seconds."""
     best = FASTEST.replace(max_seconds=limit)
-    ours(g, s, e, exact, best.replace(max_seconds=WARM), (0, k, 1))
-    timed = ours(g, s, e, exact, best, (0, k))
+    run_ours(g, s, e, exact, (0, k, 1), best.replace(max_seconds=WARM))
+    timed = run_ours(g, s, e, exact, (0, k), best)
     rrt = PlannerConfig(eta=10.0, max_seconds=limit)
-    ours(g, s, e, exact, rrt.replace(max_seconds=WARM), (0, k, 1))
-    ours(g, s, e, exact, rrt, (0, k))
+    run_ours(g, s, e, exact, (0, k, 1), rrt.replace(max_seconds=WARM))
+    run_ours(g, s, e, exact, (0, k), rrt)
     gc.collect()
     for name in NATIVE:
         native.solve(name, s, e, 1.01 * exact, WARM, 0.0)
         native.solve(name, s, e, 1.01 * exact, limit, 0.0)
-    return timed
+    return timed["call"], timed["stop"]
 
 
 def main(argv: list[str] | None = None) -> int:
