@@ -62,7 +62,7 @@ def of(cfg: PlannerConfig, sampler: Sampler, shape: tuple[int, int]) -> Settings
                        -1 if share > 0 else 0)  # fmt: skip
     params = core.Params(
         eta=float(cfg.eta),
-        gamma=0.0,  # the map's, when shrinking: _setup
+        gamma=0.0,  # the map's, when shrinking: setup()
         radius=float(cfg.fixed_radius),
         goal_radius=float(cfg.eta if cfg.goal_radius is None else cfg.goal_radius),
         sx=0.0,  # the query's start and goal: run.query_params
