@@ -78,7 +78,7 @@ def test_the_mask_variants_and_control_are_configured_at_the_claims_tau():
     texts = [k.text for k in configurations(ev, [0.5, 0.9], 0.5)]
     assert texts[-3:] == ["m_vnrrt_star@0.5{max}", "m_vnrrt_star@0.5{noends}",
                           "m_vnrrt_star@0.5[nrrtnet]"]  # fmt: skip
-    plain = Configurations(informed=False)
+    plain = Configurations(informed=False, mask_variants=[], masked_controls=False)
     assert not any("{" in k.text or "[" in k.text for k in configurations(plain, [0.5], 0.5))
 
 

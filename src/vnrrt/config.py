@@ -12,6 +12,7 @@ names the key. :mod:`vnrrt.validate` checks the whole composition before any sta
 from __future__ import annotations
 
 import dataclasses
+import inspect
 import os
 from collections.abc import Mapping
 from pathlib import Path
@@ -30,6 +31,56 @@ T = TypeVar("T")
 
 class ConfigError(ValueError):
     """A configuration value or key is invalid; the message names it."""
+
+
+def conf_file(group: str, option: str = "default", node: str | None = None) -> dict:
+    """The keys of ``conf/<group>/<option>.yaml`` (under its top-level ``node`` where given,
+    e.g. ``scale`` in a ``# @package _global_`` file) as plain Python values; YAML's
+    ``.inf`` is ``math.inf``, ``null`` is None. :class:`ConfigError` names a missing or
+    malformed file."""
+    import yaml
+
+    path = CONF_DIR / group / f"{option}.yaml"
+    try:
+        doc = yaml.safe_load(path.read_text())
+    except (OSError, yaml.YAMLError) as err:
+        raise ConfigError(f"config file {path} cannot be read: {err}") from None
+    if node is not None:
+        doc = doc.get(node) if isinstance(doc, dict) else None
+    if not isinstance(doc, dict):
+        raise ConfigError(f"config file {path} has no mapping{f' under {node!r}' if node else ''}")
+    return doc
+
+
+def conf_defaults(group: str, option: str = "default", node: str | None = None):
+    """Class decorator, applied below ``@dataclass``: the defaults of the class's own fields
+    are the values of ``conf/<group>/<option>.yaml`` (:func:`conf_file`), so the library's
+    defaults and the pipeline's are one source. Every own field must be in the file
+    (:class:`ConfigError` otherwise); the file may hold more keys (a section's subset)."""
+
+    def wrap(cls: type[T]) -> type[T]:
+        values = conf_file(group, option, node)
+        names = list(inspect.get_annotations(cls))
+        missing = [n for n in names if n not in values]
+        if missing:
+            raise ConfigError(f"conf/{group}/{option}.yaml lacks {missing} ({cls.__name__})")
+        for name in names:
+            value = values[name]
+            if isinstance(value, list | dict):
+                default = dataclasses.field(default_factory=_copier(value))
+            else:
+                default = value
+            setattr(cls, name, default)
+        return cls
+
+    return wrap
+
+
+def _copier(value):
+    """A default factory returning a fresh deep copy of ``value``."""
+    import copy
+
+    return lambda: copy.deepcopy(value)
 
 
 def check_parts(parts, key: str) -> list[int]:
@@ -53,8 +104,8 @@ def section(cfg: DictConfig | dict, key: str, schema: type[T]) -> T:
     """Return ``cfg[key]`` as a validated ``schema`` instance.
 
     Unknown or missing keys, missing sections and wrong types raise :class:`ConfigError`
-    naming the offending ``key.subkey`` (defaults of the dataclasses serve library callers;
-    a composed config must give every key).
+    naming the offending ``key.subkey`` (the dataclasses' defaults, read from ``conf/`` by
+    :func:`conf_defaults`, serve library callers; a composed config must give every key).
     """
     from omegaconf import DictConfig, OmegaConf
     from omegaconf.errors import OmegaConfBaseException

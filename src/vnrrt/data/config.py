@@ -3,18 +3,19 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
-from vnrrt.config import check
+from vnrrt.config import check, conf_defaults
 
 
 @dataclass
+@conf_defaults("labels")
 class LabelsConfig:
     """Vertex labelling (paper, Method/Ground Truth)."""
 
-    vertex_steps: list[int] = field(default_factory=lambda: [1, 2, 3])
-    tie_break: str = "line"  # among equally short A* paths: turns | line | exact
-    tie_tolerance: float = 8.0  # px: line/exact keep the direction while this near the guide
+    vertex_steps: list[int]
+    tie_break: str  # among equally short A* paths: turns | line | exact
+    tie_tolerance: float  # px: line/exact keep the direction while this near the guide
 
     def validate(self) -> None:
         ok = bool(self.vertex_steps) and all(k >= 1 for k in self.vertex_steps)
@@ -25,12 +26,13 @@ class LabelsConfig:
 
 
 @dataclass
+@conf_defaults("scale", "quick", node="scale")
 class ScaleConfig:
     """How much data: ``len(shards) * maps_per_shard`` maps, 144 instances each by default."""
 
-    name: str = "quick"
-    maps_per_shard: int = 50
-    shards: list[int] = field(default_factory=lambda: [0, 1, 2, 3])
+    name: str
+    maps_per_shard: int
+    shards: list[int]
 
     def validate(self) -> None:
         check(self.maps_per_shard >= 1, "scale.maps_per_shard", self.maps_per_shard, ">= 1")

@@ -2,37 +2,38 @@
 ``conf/oracle`` and ``conf/regime``: one module, one dataclass per section.
 
 The pipeline builds them only through :func:`vnrrt.config.section` from the composed config,
-which must give every key: the dataclass defaults (the paper's values where it has them)
-serve library callers and never stand in for a config key inside the pipeline.
+which must give every key. A library caller's defaults (``EvalConfig()``) are the group's
+default file in ``conf/`` (:func:`vnrrt.config.conf_defaults`): one source, never written
+again here.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
-from vnrrt.config import ConfigError, check, check_parts
+from vnrrt.config import ConfigError, check, check_parts, conf_defaults
 from vnrrt.evaluation.keys import MASK_VARIANTS, ConfigKey
 from vnrrt.evaluation.oracles import ORACLE_KINDS
 from vnrrt.names import PLANNERS, mask_taus
 
-DEFAULT_SOURCES = {"nrrt_star": "nrrtnet", "vnrrt_star": "vertexnet", "m_vnrrt_star": "vertexnet"}
 REGIME_RADIUS_MODES = ("shrinking", "fixed1", "fixed2")  # fixedK: a fixed near radius K x eta
 
 
 @dataclass
+@conf_defaults("eval")
 class Configurations:
     """``eval.planners``, ``eval.sources`` and ``eval.informed``: which configurations run
     (:func:`vnrrt.evaluation.protocol.configurations`), for the stages that read only these."""
 
-    planners: list[str] = field(default_factory=lambda: list(PLANNERS))
+    planners: list[str]
     # planner -> heatmap source it samples (a network name of `networks`, or an oracle)
-    sources: dict[str, str] = field(default_factory=lambda: dict(DEFAULT_SOURCES))
-    informed: bool = True  # also every configuration with informed sampling (random maps)
-    mask_variants: list[str] = field(default_factory=list)  # M-VNRRT* at planner.tau, masked so
-    masked_controls: bool = False  # M-VNRRT* at planner.tau on the NRRT* network's heatmap
-    endpoint_radius: float = 3.0  # start/goal disks (px): the noends mask, the mass shares
-    zero_obstacles: bool = False  # the obstacle rule: sample free cells only (heatmaps, uniform)
+    sources: dict[str, str]
+    informed: bool  # also every configuration with informed sampling (random maps)
+    mask_variants: list[str]  # M-VNRRT* at planner.tau with these masks too
+    masked_controls: bool  # M-VNRRT* at planner.tau on the NRRT* network's heatmap
+    endpoint_radius: float  # start/goal disks (px): the noends mask, the mass shares
+    zero_obstacles: bool  # the obstacle rule: sample free cells only (heatmaps, uniform)
 
     def validate(self) -> None:
         """Raise :class:`ConfigError` naming the first invalid value."""
@@ -57,17 +58,18 @@ class Configurations:
 
 
 @dataclass
+@conf_defaults("eval")
 class EvalConfig(Configurations):
     """The ``eval`` section (paper, Experiments). Trial counts are per instance."""
 
-    named_initial: int = 1000  # paper: 1,000 trials per named map
-    named_optimal: int = 100  # paper: 100
-    random_maps: int = 1000  # paper: 1,000 random test maps (R instances), one trial each
-    random_initial: int = 1
-    random_optimal: int = 1
-    any_angle: bool = True  # also the optimal_any_angle stop rule (exact optimum)
-    gpu: bool = False  # also the GPU-trained paper networks (paths.gpu_returned) as sources
-    parts: list[int] = field(default_factory=lambda: [0])  # trial parts: [0, 1, ..., K-1]
+    named_initial: int  # paper: 1,000 trials per named map
+    named_optimal: int  # paper: 100
+    random_maps: int  # paper: 1,000 random test maps (R instances), one trial each
+    random_initial: int
+    random_optimal: int
+    any_angle: bool  # also the optimal_any_angle stop rule (exact optimum)
+    gpu: bool  # also the GPU-trained paper networks (paths.gpu_returned) as sources
+    parts: list[int]  # trial parts: [0, 1, ..., K-1]
 
     def validate(self) -> None:
         """Raise :class:`ConfigError` naming the first invalid value."""
@@ -87,13 +89,14 @@ class EvalConfig(Configurations):
 
 
 @dataclass
+@conf_defaults("planner")
 class Rules:
     """``planner.eps``, ``planner.taus`` and ``planner.tau``: the stop tolerance and the
     M-VNRRT* thresholds, for the stages that name them without planning."""
 
-    eps: float = 0.01
-    taus: list[float] = field(default_factory=lambda: [0.5, 0.9, 0.99])
-    tau: float = 0.5
+    eps: float
+    taus: list[float]
+    tau: float
 
     def validate(self) -> None:
         check(self.eps >= 0, "planner.eps", self.eps, "must be >= 0")
@@ -107,14 +110,15 @@ class Rules:
 
 
 @dataclass
+@conf_defaults("stats")
 class StatsConfig:
     """The ``stats`` section: bootstrap confidence intervals and the verdict rules."""
 
-    bootstrap: int = 2000  # resamples of every confidence interval
-    level: float = 0.95  # confidence level of intervals and verdicts (family-wise for claims)
-    tail_draws: int = 50  # bootstrap draws in each tail at the claims' corrected level
-    untestable_endpoint_share: float = 0.5  # a masked sampler with more on start/goal ...
-    untestable_fallback: float = 0.5  # ... or falling back to uniform more often: untestable
+    bootstrap: int  # resamples of every confidence interval
+    level: float  # confidence level of intervals and verdicts (family-wise for claims)
+    tail_draws: int  # bootstrap draws in each tail at the claims' corrected level
+    untestable_endpoint_share: float  # a masked sampler with more on start/goal ...
+    untestable_fallback: float  # ... or falling back to uniform more often: untestable
 
     def validate(self) -> None:
         if not isinstance(self.bootstrap, int) or self.bootstrap < 100:
@@ -129,25 +133,22 @@ class StatsConfig:
 
 
 @dataclass
+@conf_defaults("oracle")
 class OracleConfig:
     """The ``oracle`` section: the oracle families of the sampling-ideas study
     (:mod:`vnrrt.evaluation.sampling_ideas`)."""
 
-    families: dict[str, list[str]] = field(default_factory=lambda: {
-        "path": ["oracle_path", "oracle_taut_path"],
-        "vertex": ["oracle_vertex", "oracle_vertex_endpoints", "oracle_taut_vertex"],
-        "control": ["oracle_endpoints"],
-    })  # fmt: skip
-    sigmas: list[float] = field(default_factory=lambda: [1.0, 2.0, 4.0, 8.0, 16.0])
-    mixes: list[float] = field(default_factory=lambda: [0.25, 0.5, 0.75])
-    blend_weights: list[float] = field(default_factory=lambda: [0.0, 0.25, 0.5, 0.75, 1.0])
-    floor: float = 0.0
-    radius: float = 3.0
-    qualities: list[float] = field(default_factory=lambda: [1.0, 0.5, 0.2, 0.1, 0.05, 0.02, 0.0])
-    random_maps: int = 1000
-    selection_share: float = 0.5
-    trials: int = 2
-    parts: list[int] = field(default_factory=lambda: [0])
+    families: dict[str, list[str]]
+    sigmas: list[float]
+    mixes: list[float]
+    blend_weights: list[float]
+    floor: float
+    radius: float
+    qualities: list[float]
+    random_maps: int
+    selection_share: float
+    trials: int
+    parts: list[int]
 
     def validate(self) -> None:
         check(set(self.families) >= {"path", "vertex"}, "oracle.families", list(self.families),
@@ -174,17 +175,18 @@ class OracleConfig:
 
 
 @dataclass
+@conf_defaults("regime")
 class RegimeConfig:
     """The ``regime`` section: the planner-regime sweep (its cells and configurations)."""
 
-    etas: list[float] = field(default_factory=lambda: [5.0, 10.0, 20.0, 40.0, math.inf])
-    radius_modes: list[str] = field(default_factory=lambda: ["shrinking", "fixed1"])
-    gamma_factors: list[float] = field(default_factory=lambda: [1.0, 0.1, 0.01])
-    goal_radii: list = field(default_factory=lambda: [None, math.inf])
-    configurations: list[str] = field(default_factory=lambda: ["rrt_star"])
-    random_maps: int = 1000
-    trials: int = 2
-    parts: list[int] = field(default_factory=lambda: [0])
+    etas: list[float]
+    radius_modes: list[str]
+    gamma_factors: list[float]
+    goal_radii: list
+    configurations: list[str]
+    random_maps: int
+    trials: int
+    parts: list[int]
 
     def validate(self) -> None:
         ok = bool(self.etas) and all(e > 0 for e in self.etas)

@@ -3,27 +3,28 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
-from vnrrt.config import check
+from vnrrt.config import check, conf_defaults
 from vnrrt.maps.shapes import SHAPES
 
 
 @dataclass
+@conf_defaults("data")
 class DataConfig:
     """Random floor maps (paper, Experiments/Data). Sizes and distances in pixels."""
 
-    size: int = 200
-    n_obstacles: list[int] = field(default_factory=lambda: [8, 18])  # [min, max] per map
-    shapes: list[str] = field(default_factory=lambda: list(SHAPES))
-    obstacle_size: list[float] = field(default_factory=lambda: [14.0, 44.0])  # [min, max]
-    bar_width: list[float] = field(default_factory=lambda: [4.0, 9.0])  # [min, max]
-    n_starts: int = 12
-    n_goals: int = 12
-    min_start_goal_distance: float = 20.0
-    min_free_fraction: float = 0.5  # of the map, in the start/goal component
-    max_attempts: int = 50
-    train_fraction: float = 0.7
+    size: int
+    n_obstacles: list[int]  # [min, max] per map
+    shapes: list[str]
+    obstacle_size: list[float]  # [min, max]
+    bar_width: list[float]  # [min, max]
+    n_starts: int
+    n_goals: int
+    min_start_goal_distance: float
+    min_free_fraction: float  # of the map, in the start/goal component
+    max_attempts: int
+    train_fraction: float
 
     def validate(self) -> None:
         """Raise :class:`ConfigError` naming the first inconsistent value."""

@@ -13,21 +13,22 @@ pipeline's training itself (same settings, same fingerprint). Nothing here impor
 from __future__ import annotations
 
 import copy
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
-from vnrrt.config import check
+from vnrrt.config import check, conf_defaults
 
 REPORT = "training_budget"  # the one name of stage budget_report@<name> (budget.report)
 
 
 @dataclass
+@conf_defaults("budget")
 class BudgetConfig:
     """The ``budget`` section: ``steps``, the budgets (optimizer steps, ascending), and
     ``report``, ``[training_budget]`` where there are budgets and ``[]`` where there are
     none (DVC makes no report stage of a foreach over ``[]``)."""
 
-    steps: list[int] = field(default_factory=list)
-    report: list[str] = field(default_factory=list)
+    steps: list[int]
+    report: list[str]
 
     def validate(self) -> None:
         steps = self.steps

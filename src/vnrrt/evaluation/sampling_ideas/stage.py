@@ -18,7 +18,7 @@ from pathlib import Path
 
 from omegaconf import DictConfig
 
-from vnrrt.config import ConfigError, check_parts, section, sections
+from vnrrt.config import ConfigError, check_parts, conf_defaults, section, sections
 from vnrrt.evaluation.config import Configurations, OracleConfig, RegimeConfig, Rules
 from vnrrt.paths import Paths
 
@@ -26,6 +26,7 @@ log = logging.getLogger(__name__)
 
 
 @dataclass
+@conf_defaults("planner")
 class StudyRules(Rules):
     """:class:`~vnrrt.evaluation.config.Rules` and the planner settings a regime cell
     overrides (``planner.eta``, ``radius_mode``, ``gamma_factor``, ``fixed_radius``,
@@ -33,11 +34,11 @@ class StudyRules(Rules):
     stage ``ideas``, which plans nothing: they say which grid cell is the protocol's own
     (:func:`.design.protocol_settings`)."""
 
-    eta: float = 10.0
-    radius_mode: str = "shrinking"
-    gamma_factor: float = 1.0
-    fixed_radius: float = 10.0
-    goal_radius: float | None = None
+    eta: float
+    radius_mode: str
+    gamma_factor: float
+    fixed_radius: float
+    goal_radius: float | None
 
 
 @dataclass(frozen=True)

@@ -35,6 +35,7 @@ class BudgetTrials:
         """The configurations, in the protocol's order (``rrt_star``, ``nrrt_star``,
         ``vnrrt_star``, ``m_vnrrt_star@<tau>`` as configured)."""
         ev = Configurations(list(self.planners), dict(self.sources), informed=False,
+                            mask_variants=[], masked_controls=False,
                             endpoint_radius=self.endpoint_radius,
                             zero_obstacles=self.zero_obstacles)  # fmt: skip
         return configurations(ev, [tau], tau)
