@@ -149,6 +149,7 @@ CODE = re.compile(r"```.*?```|`[^`\n]*`", flags=re.S)
 LINK_TARGET = re.compile(r"\]\(([^)\s]+)\)")
 # The paper's own figure, table, algorithm and map numbers, and the generated blocks.
 NAMED = re.compile(r"\b(?:Fig\.|Figs\.|Tables?|Algorithms?|Maps?|seeds?)\s+\d+(?:[-,]\s*\d+)*")
+LIST_ITEM = re.compile(r"^\s*\d+\.\s", flags=re.M)  # an ordered list's "1. "
 GENERATED = re.compile(r"<!-- begin (\w+) -->.*?<!-- end \1 -->", flags=re.S)
 
 
@@ -180,6 +181,15 @@ def sections(text: str) -> list[tuple[str, str]]:
     return [("", parts[0]), *zip(parts[1::2], parts[2::2], strict=True)]
 
 
+def broken_links(page: Path) -> list[str]:
+    """The relative link targets of ``page`` (anchors aside) that name no file or folder."""
+    targets = LINK_TARGET.findall(CODE.sub(" ", page.read_text()))
+    return [
+        t for t in targets if "://" not in t and not t.startswith("#")
+        and not (page.parent / t.split("#")[0]).exists()
+    ]  # fmt: skip
+
+
 def unsourced_numbers(page: Path) -> list[str]:
     """'section: number' for each number of ``page`` (code spans, code blocks, link targets,
     the paper's figure/table/map numbers and generated blocks left out) that no file linked
@@ -188,7 +198,7 @@ def unsourced_numbers(page: Path) -> list[str]:
     for heading, body in sections(page.read_text()):
         prose = GENERATED.sub(" ", CODE.sub(" ", body))
         links = [t for t in LINK_TARGET.findall(prose) if "://" not in t]
-        prose = NAMED.sub(" ", LINK_TARGET.sub("]", prose))
+        prose = LIST_ITEM.sub(" ", NAMED.sub(" ", LINK_TARGET.sub("]", prose)))
         source_text = ""
         for target in links:
             path = (page.parent / target.split("#")[0]).resolve()

@@ -13,7 +13,15 @@ from pathlib import Path
 import pytest
 import yaml
 
-from tests.docs_tables import PAGES, ROOT, TABLES, block, generated, unsourced_numbers
+from tests.docs_tables import (
+    PAGES,
+    ROOT,
+    TABLES,
+    block,
+    broken_links,
+    generated,
+    unsourced_numbers,
+)
 
 # docs/architecture.md is written and checked with the code layout (tests of the layout).
 CHECKED = [p for p in PAGES if p.name != "architecture.md"]
@@ -37,6 +45,11 @@ def test_generated_tables_equal_their_rendering_from_the_reports(page):
             f"{page.name}: table '{name}' differs from reports/cpu; "
             "run `python -m tests.docs_tables` after a new CPU-scale run"
         )
+
+
+@pytest.mark.parametrize("page", CHECKED, ids=_ids(CHECKED))
+def test_every_link_names_a_file_here(page):
+    assert broken_links(page) == []
 
 
 @pytest.mark.parametrize("page", CHECKED, ids=_ids(CHECKED))
@@ -103,11 +116,11 @@ def _options(source: Path) -> set[str]:
 
 
 def _module_file(name: str) -> Path:
-    base = ROOT / "src" / Path(*name.split("."))
-    for path in (base.with_suffix(".py"), base / "__main__.py"):
-        if path.is_file():
-            return path
-    raise AssertionError(f"no module {name} under src/")
+    for base in (ROOT / "src" / Path(*name.split(".")), ROOT / Path(*name.split("."))):
+        for path in (base.with_suffix(".py"), base / "__main__.py"):
+            if path.is_file():
+                return path
+    raise AssertionError(f"no module {name} in src/ or the repository")
 
 
 def _check_python(argv: list[str]) -> None:
