@@ -21,7 +21,8 @@ same run.
   test instances of the quick shards: interior-vertex AP and recall, and the mass within
   3 px of the interior vertices in multiples of a uniform map's.
 
-``data`` and ``learning`` need the quick-scale shards (``dvc repro manifest``). Examples:
+``data`` and ``learning`` need the quick-scale shards (``dvc repro manifest``). Without a
+mode (``make bench``) every mode runs in turn at its defaults. Examples:
 
     python benchmarks/bench_training.py step --device cpu --batch 4 --steps 3
     python benchmarks/bench_training.py step --device cuda --batch 256 --steps 20 --compile
@@ -292,7 +293,7 @@ def run_loop(args: argparse.Namespace) -> None:
 def parser() -> argparse.ArgumentParser:
     """The command line (module doc)."""
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    sub = p.add_subparsers(dest="mode", required=True)
+    sub = p.add_subparsers(dest="mode")  # none: every mode in turn, at its defaults
     step = sub.add_parser("step", help="bare step and inference of a VertexNet, CPU/CUDA")
     step.set_defaults(run=run_step)
     step.add_argument("--device", default="auto", help="cpu, cuda or auto (both when there)")
@@ -325,13 +326,19 @@ def parser() -> argparse.ArgumentParser:
     return p
 
 
+MODES = ("step", "settings", "loop", "data", "learning")
+
+
 def main(argv: list[str] | None = None) -> None:
     args = parser().parse_args(argv)
     logging.getLogger("lightning").setLevel(logging.WARNING)
     print(f"cores: {os.cpu_count()}, torch {torch.__version__}, threads {torch.get_num_threads()}")
-    if args.mode in {"data", "learning"} and not Path("data/quick/manifest.json").is_file():
-        raise SystemExit("needs the quick-scale shards: run `dvc repro manifest` first")
-    args.run(args)
+    runs = [args] if args.mode else [parser().parse_args([mode]) for mode in MODES]
+    for run in runs:
+        if run.mode in {"data", "learning"} and not Path("data/quick/manifest.json").is_file():
+            raise SystemExit("needs the quick-scale shards: run `dvc repro manifest` first")
+        print(f"\n{run.mode}:")
+        run.run(run)
 
 
 if __name__ == "__main__":
