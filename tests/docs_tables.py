@@ -181,13 +181,25 @@ def sections(text: str) -> list[tuple[str, str]]:
     return [("", parts[0]), *zip(parts[1::2], parts[2::2], strict=True)]
 
 
+def anchors(page: Path) -> set[str]:
+    """The heading anchors of a markdown page, as GitHub makes them."""
+    text = re.sub(r"```.*?```", " ", page.read_text(), flags=re.S)
+    heads = re.findall(r"^#+ (.*)$", text, flags=re.M)
+    return {re.sub(r"[^\w\- ]", "", h.lower()).replace(" ", "-") for h in heads}
+
+
 def broken_links(page: Path) -> list[str]:
-    """The relative link targets of ``page`` (anchors aside) that name no file or folder."""
-    targets = LINK_TARGET.findall(CODE.sub(" ", page.read_text()))
-    return [
-        t for t in targets if "://" not in t and not t.startswith("#")
-        and not (page.parent / t.split("#")[0]).exists()
-    ]  # fmt: skip
+    """The relative link targets of ``page`` that name no file or folder, or no heading of
+    the markdown page they name (``file.md#heading``, ``#heading``)."""
+    broken = []
+    for target in LINK_TARGET.findall(CODE.sub(" ", page.read_text())):
+        if "://" in target:
+            continue
+        path, _, anchor = target.partition("#")
+        file = page.parent / path if path else page
+        if not file.exists() or (anchor and file.suffix == ".md" and anchor not in anchors(file)):
+            broken.append(target)
+    return broken
 
 
 def unsourced_numbers(page: Path) -> list[str]:

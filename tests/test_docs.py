@@ -174,3 +174,13 @@ def test_every_command_names_what_exists(page, argv, capsys):
         assert (ROOT / program).is_file(), f"{page.name}: no script {program}"
     else:
         assert program in OTHER_TOOLS | {"cp", "mkdir", "export"}, f"unchecked command {argv}"
+
+
+def test_the_link_check_catches_missing_files_and_headings(tmp_path):
+    (tmp_path / "other.md").write_text("# Title\n\n## The paper's claims\n")
+    page = tmp_path / "page.md"
+    page.write_text(
+        "[a](other.md#the-papers-claims) [b](other.md#gone) [c](missing.md) [d](#here)\n"
+        "## Here\n[e](https://example.org/x) `[f](in-code.md)`\n"
+    )
+    assert broken_links(page) == ["other.md#gone", "missing.md"]
