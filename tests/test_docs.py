@@ -144,10 +144,13 @@ def _check_dvc(argv: list[str], capsys) -> None:
         overrides = [argv[i + 1] for i, a in enumerate(argv) if a == "-S"]
         targets = [a for i, a in enumerate(argv[3:], 3) if not a.startswith("-")
                    and argv[i - 1] != "-S"]  # fmt: skip
-        for override in overrides:  # a sweep 'k=a,b' composes each value
-            key, _, values = override.partition("=")
-            for value in values.split(",") if "[" not in values else [values]:
-                assert compose([f"{key}={value}"]) == 0, f"-S {override} does not compose"
+        fixed = [o for o in overrides if "," not in o or "[" in o]
+        sweeps = [o for o in overrides if o not in fixed] or ["="]
+        for sweep in sweeps:  # a sweep 'k=a,b' composes each value with the fixed ones
+            key, _, values = sweep.partition("=")
+            for value in values.split(","):
+                run = fixed + ([f"{key}={value}"] if key else [])
+                assert compose(run) == 0, f"-S {' -S '.join(run)} does not compose"
         capsys.readouterr()
         assert set(targets) <= _stages(), f"unknown stage in {targets}"
     elif argv[1] in {"repro", "status", "commit"}:
