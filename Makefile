@@ -43,7 +43,7 @@ CPU_REPORTS := reports/cpu
 # The study's reports first, so that a run cut short still leaves them: the pipeline at
 # train.seed 0 (paper comparison and sampling ideas), then both networks at train.seed 1, then
 # the training-budget curve at seed 0. Wall time measured on 2026-12-02 (2-core AVX-512 machine
-# with bf16; see the README): ~38 min for the data and both trainings, ~2 min trials, ~4 min
+# with bf16): ~38 min for the data and both trainings, ~2 min trials, ~4 min
 # oracle selection, ~26 min the oracle evaluation and regime grid (regime@0, 49,980 jobs of 2
 # planner runs), ~3 min the reports; ~37 min for seed 1's trainings; ~63 min the budget
 # curve.

@@ -32,7 +32,7 @@ import numpy as np
 import pandas as pd
 import torch
 
-import bench_model  # benchmarks/ is on sys.path when this script runs
+from bench_training import step_rates  # benchmarks/ is on sys.path when this script runs
 from vnrrt.config import compose, section
 from vnrrt.data.build import build_shard
 from vnrrt.data.config import LabelsConfig
@@ -42,7 +42,7 @@ from vnrrt.evaluation.config import EvalConfig
 from vnrrt.evaluation.protocol import configurations, trial_counts
 from vnrrt.evaluation.table import read_table
 from vnrrt.maps.config import DataConfig
-from vnrrt.model import VertexNet
+from vnrrt.model import FocalLoss, VertexNet
 from vnrrt.names import mask_taus
 from vnrrt.parallel import n_workers
 from vnrrt.planners import PlannerConfig, plan, warmup
@@ -72,7 +72,7 @@ def loader_rate(shard: Path, n: int) -> float:
 
 def network_rates(batch: int, steps: int, device: torch.device) -> dict[str, float]:
     """Training and inference images/s of the paper network on ``device`` (bf16 and
-    channels_last on CUDA; :func:`bench_model.bench`), and its training GFLOPs per image
+    channels_last on CUDA; :func:`bench_training.step_rates`), and its training GFLOPs per image
     (forward + backward)."""
     from torch.utils.flop_counter import FlopCounterMode
 
@@ -80,10 +80,9 @@ def network_rates(batch: int, steps: int, device: torch.device) -> dict[str, flo
     with FlopCounterMode(display=False) as flops:
         net(torch.rand(1, 3, 200, 200, device=device)).sum().backward()
     gpu = device.type == "cuda"
-    run = argparse.Namespace(encoder="resnet34", width=1.0, batch=batch, size=200, steps=steps,
-                             warmup=1, compile=False, bf16=gpu, channels_last=gpu)  # fmt: skip
-    rates = bench_model.bench(run, device)
-    return {"train": rates["train_images_per_s"], "infer": rates["infer_images_per_s"],
+    rates = step_rates(net, FocalLoss(gamma=2.0), device, batch=batch, channels_last=gpu,
+                       bf16=gpu, steps=steps, infer=True)  # fmt: skip
+    return {"train": rates["train"], "infer": rates["infer"],
             "train_gflops": flops.get_total_flops() / 1e9}  # fmt: skip
 
 

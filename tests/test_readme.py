@@ -1,5 +1,5 @@
-"""The README's library and command-line examples work as written: its Python blocks run in
-order (a block that reads pipeline outputs runs when `make repro` has made them), and every
+"""The README's and docs/library.md's examples work as written: each page's Python blocks run
+in order (a block that reads pipeline outputs runs when `make repro` has made them), and every
 `vnrrt ...` line parses with the real command line; where its input files exist, it runs
 and exits 0."""
 
@@ -10,14 +10,15 @@ from pathlib import Path
 import pytest
 
 from vnrrt.cli import build_parser, main
+from vnrrt.search import any_angle_path
 
 ROOT = Path(__file__).resolve().parents[1]
-README = (ROOT / "README.md").read_text()
+PAGES = [ROOT / "README.md", ROOT / "docs" / "library.md"]
 PIPELINE_FILE = re.compile(r"(?:data|models)/[\w./-]+\.(?:npz|ckpt)")
 
 
-def _blocks(lang: str) -> list[str]:
-    return re.findall(rf"```{lang}\n(.*?)```", README, flags=re.S)
+def _blocks(page: Path, lang: str) -> list[str]:
+    return re.findall(rf"```{lang}\n(.*?)```", page.read_text(), flags=re.S)
 
 
 def _missing(text: str) -> list[str]:
@@ -25,24 +26,35 @@ def _missing(text: str) -> list[str]:
 
 
 def _commands() -> list[list[str]]:
-    lines = [line for block in _blocks("bash") for line in block.splitlines()]
+    lines = [ln for page in PAGES for block in _blocks(page, "bash") for ln in block.splitlines()]
     return [shlex.split(line, comments=True) for line in lines if line.startswith("vnrrt ")]
 
 
-def test_the_python_examples_run(monkeypatch, tmp_path):
-    monkeypatch.chdir(ROOT)
-    blocks = _blocks("python")
-    assert blocks, "the README has no Python example"
+def _run(page: Path) -> dict:
+    """Run the page's Python blocks in order in one namespace; returns it."""
+    blocks = _blocks(page, "python")
+    assert blocks, f"{page.name} has no Python example"
     namespace: dict = {}
-    ran = 0
     for block in blocks:
-        if _missing(block):  # needs `make repro` first
-            continue
-        exec(compile(block, "README.md", "exec"), namespace)
-        ran += 1
-    assert ran >= 1
-    result = namespace["result"]  # the first example plans to the exact optimum
-    assert result.success and result.cost <= 1.01 * namespace["exact"] + 1e-9
+        if not _missing(block):  # else it needs `make repro` first
+            exec(compile(block, page.name, "exec"), namespace)
+    return namespace
+
+
+def test_the_readme_quick_start_reaches_the_exact_optimum(monkeypatch):
+    monkeypatch.chdir(ROOT)
+    ns = _run(ROOT / "README.md")
+    _, exact = any_angle_path(ns["grid"], ns["start"], ns["goal"])  # independent reference
+    result, fastest = ns["result"], ns["fastest"]
+    assert isinstance(result, ns["PlanResult"]) and result.planner == "vnrrt_star"
+    assert result.success and exact - 1e-9 <= result.cost <= 1.01 * exact + 1e-9
+    assert fastest.success and fastest.cost >= exact - 1e-9
+
+
+def test_the_library_examples_run(monkeypatch):
+    monkeypatch.chdir(ROOT)
+    ns = _run(ROOT / "docs" / "library.md")  # the blocks assert their own results
+    assert ns["first"].success and ns["first"].cost >= ns["exact"] - 1e-9
 
 
 @pytest.mark.parametrize("argv", _commands(), ids=lambda a: " ".join(a[1:4]))
