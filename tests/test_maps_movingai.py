@@ -4,6 +4,8 @@ error naming its line."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
@@ -166,3 +168,38 @@ def test_scenarios_that_do_not_fit_the_map_are_named_by_line(tmp_path):
     (tmp_path / "s.scen").write_text(V1 + on_wall + "\n")
     why = blocked_endpoint(grid, read_scen(tmp_path / "s.scen")[0])
     assert why == "line 2: goal (1, 1) lies on an obstacle of the map"
+
+
+def _published_lengths_checked(name: str, every: int) -> int:
+    """A* against the published optimal length of every ``every``-th query of each bucket of
+    ``name``'s ``version 1`` file; returns how many were checked."""
+    from vnrrt.search import astar
+
+    grid = read_map(SHIPPED / f"{name}.map")
+    scen = read_scen(SHIPPED / f"{name}.map.scen")
+    seen: dict[int, int] = {}
+    checked = 0
+    for s in scen:
+        seen[s.bucket] = seen.get(s.bucket, -1) + 1
+        if seen[s.bucket] % every:
+            continue
+        _, length = astar(grid, s.start, s.goal)
+        # 6 significant digits written: within one unit of the last (the generator's sums
+        # round a little differently from ours, by up to 0.51 of a unit on these files)
+        unit = 10.0 ** (math.floor(math.log10(s.optimal)) - 5) if s.optimal > 0 else 1e-9
+        assert abs(length - s.optimal) <= unit, (name, s.line, length, s.optimal)
+        checked += 1
+    return checked
+
+
+@pytest.mark.parametrize("name", ["arena", "lak304d", "64room_000"])
+def test_astar_equals_the_published_optimum_on_a_sample_of_each_bucket(name):
+    # every 4th query of each bucket (the 1st, 5th, 9th of 10); all of them: the slow test
+    checked = _published_lengths_checked(name, 4)
+    assert checked == {"arena": 48, "lak304d": 232, "64room_000": 609}[name]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["arena", "lak304d", "64room_000"])
+def test_astar_equals_the_published_optimum_on_every_version_1_scenario(name):
+    assert _published_lengths_checked(name, 1) == SCEN_COUNTS[name]
