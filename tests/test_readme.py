@@ -13,7 +13,7 @@ from vnrrt.cli import build_parser, main
 
 ROOT = Path(__file__).resolve().parents[1]
 README = (ROOT / "README.md").read_text()
-PIPELINE_FILE = re.compile(r"(?:data|models)/[\w./-]+\.(?:npz|ckpt)")
+PIPELINE_FILE = re.compile(r"(?:data|models)/[\w./-]+\.(?:npz|ckpt|map|scen)")
 
 
 def _blocks(lang: str) -> list[str]:
