@@ -94,3 +94,14 @@ def test_predict_reads_a_movingai_map(ckpt, tmp_path, capsys):
     assert heat.shape == read_map(path).shape == (194, 193)
     assert np.array_equal(heat, heatmap(ckpt, read_map(path), (10, 115), (116, 182), pad=True))
     assert "heatmap 193x194" in capsys.readouterr().out
+
+
+def test_a_scen_batch_plans_with_a_checkpoints_heatmaps(ckpt, capsys):
+    mai = REPO / "data" / "movingai"
+    base = ["plan", "--map", str(mai / "lak304d.map"), "--scen", str(mai / "lak304d.map.scen"),
+            "--longest", "2", "--checkpoint", str(ckpt), "--pad"]  # fmt: skip
+    assert main([*base, "--planner", "vnrrt_star"]) == 0
+    out = capsys.readouterr().out
+    assert "solved 2 of 2 planned" in out and "planner vnrrt_star" in out
+    assert main([*base, "--planner", "nrrt_star"]) == 2  # a vertex network: not NRRT*'s target
+    assert "predicts vertex heatmaps, not the path heatmaps" in capsys.readouterr().err

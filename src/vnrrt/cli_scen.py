@@ -59,12 +59,15 @@ def pick(scenarios: list, rows: str | None, longest: int | None, limit: int | No
 
 
 def _heat(args, grid: np.ndarray, s):
-    """The ``--checkpoint`` network's heatmap of query ``s``, or None without one."""
-    if not args.checkpoint:
+    """The ``--checkpoint`` network's heatmap of query ``s``, or None without one (or for
+    RRT*, which samples none)."""
+    if not args.checkpoint or args.planner == "rrt_star":
         return None
+    from vnrrt.data.targets import PLANNER_TARGETS
     from vnrrt.predict import heatmap
 
-    return heatmap(args.checkpoint, grid, s.start, s.goal, pad=args.pad)
+    target = PLANNER_TARGETS[args.planner]  # a network of the target the planner samples
+    return heatmap(args.checkpoint, grid, s.start, s.goal, target=target, pad=args.pad)
 
 
 def run_scen(args: argparse.Namespace, cfg) -> int:
