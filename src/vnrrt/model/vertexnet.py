@@ -131,8 +131,6 @@ class VertexNet(nn.Module):
             steps learning that almost every pixel is background). None: fastai's init.
     """
 
-    stride = 32  # the encoder's total downsampling (stem, max-pool, layer2-4: 2**5)
-
     def __init__(
         self,
         encoder: str = "resnet34",

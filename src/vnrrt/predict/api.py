@@ -115,11 +115,13 @@ def load_model(source: str | Path | Model) -> Model:
     return _cached(str(path.resolve()), path.stat().st_mtime)
 
 
+ENCODER_STRIDE = 32  # VertexNet's encoder downsampling: stem, max-pool, layer2-4 (2**5)
+
+
 def stride(net: torch.nn.Module) -> int:
-    """The total downsampling of a network's encoder (its ``stride`` attribute; 32, that of
-    :class:`~vnrrt.model.vertexnet.VertexNet`, for a network without one, e.g. an exported
-    program)."""
-    return int(getattr(net, "stride", 32))
+    """The total downsampling of a network's encoder: its ``stride`` attribute where it has
+    one, else :data:`ENCODER_STRIDE` (:class:`~vnrrt.model.vertexnet.VertexNet`'s)."""
+    return int(getattr(net, "stride", ENCODER_STRIDE))
 
 
 @torch.inference_mode()
