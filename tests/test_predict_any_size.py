@@ -105,3 +105,12 @@ def test_a_scen_batch_plans_with_a_checkpoints_heatmaps(ckpt, capsys):
     assert "solved 2 of 2 planned" in out and "planner vnrrt_star" in out
     assert main([*base, "--planner", "nrrt_star"]) == 2  # a vertex network: not NRRT*'s target
     assert "predicts vertex heatmaps, not the path heatmaps" in capsys.readouterr().err
+
+
+def test_plan_on_a_map_file_with_a_padded_networks_heatmap(ckpt, tmp_path, capsys):
+    args = ["plan", "--map", str(REPO / "data" / "movingai" / "lak304d.map"), "--start",
+            "10.5,115.5", "--goal", "116.5,182.5", "--planner", "vnrrt_star", "--checkpoint",
+            str(ckpt), "--pad", "--out", str(tmp_path / "plan.png")]  # fmt: skip
+    assert main(args) == 0
+    out = capsys.readouterr().out
+    assert "vnrrt_star: success=True" in out and (tmp_path / "plan.png").is_file()
