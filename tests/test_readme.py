@@ -14,7 +14,7 @@ from vnrrt.search import any_angle_path
 
 ROOT = Path(__file__).resolve().parents[1]
 PAGES = [ROOT / "README.md", ROOT / "docs" / "library.md"]
-PIPELINE_FILE = re.compile(r"(?:data|models)/[\w./-]+\.(?:npz|ckpt)")
+PIPELINE_FILE = re.compile(r"(?:data|models)/[\w./-]+\.(?:npz|ckpt|map|scen)")
 
 
 def _blocks(page: Path, lang: str) -> list[str]:

@@ -2,18 +2,22 @@
 with a trained network.
 
   vnrrt plan --map FILE [--instance NAME|I] [--start X,Y --goal X,Y] [--planner P]
-             [--heatmap FILE | --checkpoint CKPT] [--tau T] [--stop initial|optimal]
+             [--heatmap FILE | --checkpoint CKPT [--pad]] [--tau T] [--stop initial|optimal]
              [--set KEY=VALUE ...] [--out plan.png]
+  vnrrt plan --map M.map --scen M.map.scen [--scen-rows 0,5,10-19] [--longest N]
+             [--limit N] [--planner P --checkpoint CKPT] ...  (a batch: one row per query)
   vnrrt predict --checkpoint CKPT --map FILE [--instance NAME|I | --start X,Y --goal X,Y]
-             --out heatmap.npy|heatmap.png
+             [--pad] --out heatmap.npy|heatmap.png
 
 Maps: .npy occupancy (H, W), nonzero = obstacle; .npz: a dataset shard or the pipeline's
 named maps (with --instance, an index or a named map's name, e.g. u_trap); .png, read the
 same at any bit depth (8 or 16 bits, gray, RGB or palette): an opaque image whose values are
 all 0-3 is a class map (0 free, 1 obstacle, 2 start, 3 goal; a 0/1 occupancy image is one),
 any other a picture whose dark pixels (gray level below half of white, transparent pixels
-counting as white) are obstacles. Points are continuous (x, y) pixels; the cells of class
-maps and shards give their centres.
+counting as white) are obstacles; .map, a MovingAI map (., G, S passable; @, O, T, W not),
+with --scen its .scen queries (their cells' centres). Points are continuous (x, y) pixels;
+the cells of class maps and shards give their centres. --pad runs a network on the map
+padded with obstacles to multiples of its stride (32) and crops the heatmap back.
 Heatmaps: .npy (H, W), a grayscale .png scaled to [0, 1], or a pipeline heatmap file (.npz,
 with --instance and --network: it must be the heatmap of the --map instance and its own
 start and goal cells). A network (--checkpoint, or --network of a pipeline file) must have
@@ -32,6 +36,7 @@ import numpy as np
 
 from vnrrt import __version__
 from vnrrt.cli_inputs import UsageError, check_planner_target, load_heatmap, load_instance
+from vnrrt.cli_scen import add_scen_arguments, run_scen
 from vnrrt.stage_cli import EXIT_BUDGET, EXIT_HELP, EXIT_OK, run_reporting
 
 __all__ = ["UsageError", "build_parser", "load_heatmap", "load_instance", "main"]
@@ -110,15 +115,18 @@ def add_plan_command(sub: argparse._SubParsersAction) -> None:
         help="run one planner on one instance and draw it",
         description="Run one planner on one instance (see `vnrrt --help`).",
     )
-    p.add_argument("--map", type=Path, required=True, help=".npy, .png or shard/named-maps .npz")
+    p.add_argument("--map", type=Path, required=True,
+                   help=".npy, .png, MovingAI .map or shard/named-maps .npz")  # fmt: skip
     p.add_argument("--instance", help="instance index or named map (u_trap) of an .npz")
     p.add_argument("--start", type=_point, help="start point X,Y in pixels")
     p.add_argument("--goal", type=_point, help="goal point X,Y in pixels")
+    add_scen_arguments(p)
     p.add_argument("--planner", choices=PLANNERS, default="rrt_star")
     p.add_argument("--heatmap", type=Path, help="sampling heatmap .npy, .png or pipeline .npz")
     p.add_argument("--network", help="network of a pipeline heatmap .npz (vertexnet, nrrtnet)")
     p.add_argument("--row", type=int, help="row of a pipeline .npz heatmap (default: --instance's)")
     p.add_argument("--checkpoint", help="predict the heatmap with this network checkpoint")
+    p.add_argument("--pad", action="store_true", help="pad the map to the network's stride")
     p.add_argument("--tau", type=float, help="mask threshold of m_vnrrt_star, in (0, 1]")
     p.add_argument("--stop", choices=("initial", "optimal"), default="initial")
     p.add_argument("--seed", type=int, default=0)
@@ -141,7 +149,7 @@ def _heatmap(args, inst: dict, start, goal) -> np.ndarray | None:
 
         model = load_model(args.checkpoint)
         check_planner_target(model.record, args.planner, args.checkpoint)
-        return heatmap(model, inst["grid"], tuple(cells[0]), tuple(cells[1]))
+        return heatmap(model, inst["grid"], tuple(cells[0]), tuple(cells[1]), pad=args.pad)
     if not args.heatmap:
         return None
     if args.heatmap.suffix == ".npz" and "key" in inst:
@@ -160,6 +168,11 @@ def run_plan(args: argparse.Namespace) -> int:
     if args.tau is not None and not 0.0 < args.tau <= 1.0:
         raise UsageError(f"--tau {args.tau}: must be in (0, 1] (heatmaps are probabilities)")
     cfg = _planner_config(args.config, args.set)
+    if args.scen is not None:
+        return run_scen(args, cfg if args.tau is None else cfg.replace(tau=args.tau))
+    for flag in ("scen_rows", "longest", "limit"):
+        if getattr(args, flag) is not None:
+            raise UsageError(f"--{flag.replace('_', '-')} needs --scen")
     inst = load_instance(args.map, args.instance)
     start, goal = _endpoints(args, inst)
     heatmap = _heatmap(args, inst, start, goal)
@@ -193,10 +206,12 @@ def add_predict_command(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("predict", help="a trained network's heatmap for one instance",
                        description="Predict a heatmap (see `vnrrt --help`).")  # fmt: skip
     p.add_argument("--checkpoint", required=True, help="checkpoint .ckpt or MLflow model URI")
-    p.add_argument("--map", type=Path, required=True, help=".npy, .png or shard/named-maps .npz")
+    p.add_argument("--map", type=Path, required=True,
+                   help=".npy, .png, MovingAI .map or shard/named-maps .npz")  # fmt: skip
     p.add_argument("--instance", help="instance index or named map (u_trap) of an .npz")
     p.add_argument("--start", type=_point, help="start point X,Y in pixels")
     p.add_argument("--goal", type=_point, help="goal point X,Y in pixels")
+    p.add_argument("--pad", action="store_true", help="pad the map to the network's stride")
     p.add_argument("--device", default="cpu", help="torch device (default cpu)")
     p.add_argument("--out", type=Path, required=True, help="heatmap .npy (float32) or .png")
     p.set_defaults(func=run_predict)
@@ -212,7 +227,8 @@ def run_predict(args: argparse.Namespace) -> int:
     if args.out.suffix not in (".npy", ".png") or args.out.is_dir():
         raise UsageError(f"--out {args.out}: give a .npy or .png file name")
     cells = point_to_cell(np.array([start, goal]))
-    heat = heatmap(args.checkpoint, inst["grid"], tuple(cells[0]), tuple(cells[1]), args.device)
+    heat = heatmap(args.checkpoint, inst["grid"], tuple(cells[0]), tuple(cells[1]), args.device,
+                   pad=args.pad)  # fmt: skip
     from vnrrt.io import atomic_write_bytes
 
     if args.out.suffix == ".npy":

@@ -68,11 +68,15 @@ def load_instance(path: Path, instance: str | None) -> dict:
         raise UsageError(f"--instance needs a shard or named-maps .npz, not {path.suffix}")
     if path.suffix == ".npy":
         return {"grid": np.load(path)}
+    if path.suffix == ".map":  # MovingAI (vnrrt.maps.movingai): the grid only
+        from vnrrt.maps.movingai import read_map
+
+        return {"grid": read_map(path)}
     if path.suffix == ".png":
         from vnrrt.maps.image import read_map_image
 
         return {k: v for k, v in read_map_image(path).items() if v is not None}
-    raise UsageError(f"unsupported map file {path}: use .npy, .png or a shard .npz")
+    raise UsageError(f"unsupported map file {path}: use .npy, .png, .map or a shard .npz")
 
 
 def load_heatmap(
@@ -91,6 +95,10 @@ def load_heatmap(
         raise UsageError(f"heatmap file {path} not found")
     if path.suffix == ".npy":
         return np.load(path).astype(np.float64)
+    if path.suffix == ".map":  # MovingAI (vnrrt.maps.movingai): the grid only
+        from vnrrt.maps.movingai import read_map
+
+        return {"grid": read_map(path)}
     if path.suffix == ".png":
         return _read_image(path)
     if path.suffix == ".npz":

@@ -115,6 +115,15 @@ def load_model(source: str | Path | Model) -> Model:
     return _cached(str(path.resolve()), path.stat().st_mtime)
 
 
+ENCODER_STRIDE = 32  # VertexNet's encoder downsampling: stem, max-pool, layer2-4 (2**5)
+
+
+def stride(net: torch.nn.Module) -> int:
+    """The total downsampling of a network's encoder: its ``stride`` attribute where it has
+    one, else :data:`ENCODER_STRIDE` (:class:`~vnrrt.model.vertexnet.VertexNet`'s)."""
+    return int(getattr(net, "stride", ENCODER_STRIDE))
+
+
 @torch.inference_mode()
 def heatmap(
     model: str | Path | Model,
@@ -123,6 +132,7 @@ def heatmap(
     goal,
     device: str | torch.device = "cpu",
     target: str | None = None,
+    pad: bool = False,
 ) -> np.ndarray:
     """The network's probability of its positive class (vertex, or path cell) per pixel.
 
@@ -134,6 +144,10 @@ def heatmap(
         target: ``"vertex"`` or ``"path"``: refuse a network trained on the other target
             (or recording none); ``PLANNER_TARGETS[planner]`` for a planner's heatmap
             (:mod:`vnrrt.data.targets`).
+        pad: run the network on the map padded with obstacle rows and columns at the
+            bottom and right to multiples of its encoder's stride (:func:`stride`, 32), then
+            crop back: every feature level is aligned with the input at any map size (no
+            shift). False (default): the map as it is, as the networks were trained.
 
     Returns:
         ``(H, W)`` float32 in [0, 1], indexed like ``grid``.
@@ -145,13 +159,17 @@ def heatmap(
         require_target(m.record, target, str(m.record.get("source") or model))
     occ = as_occupancy(grid)
     s, g = as_cell(occ, start, "start"), as_cell(occ, goal, "goal")
-    image = render_instance(occ, s, g, **m.render)  # (3, H, W)
+    h, w = occ.shape
+    if pad:
+        k = stride(m.net)
+        occ = np.pad(occ, ((0, -h % k), (0, -w % k)), constant_values=1)
+    image = render_instance(occ, s, g, **m.render)  # (3, H, W), padded when asked
     net = m.net.to(device)
     x = torch.from_numpy(image)[None].to(device)
     autocast = torch.autocast("cuda", torch.bfloat16) if x.device.type == "cuda" else None
     with autocast or contextlib.nullcontext():
         probs = net(x).float().softmax(dim=1)[0, 1]  # (H, W)
-    out = probs.cpu().numpy().astype(np.float32)
+    out = probs[:h, :w].cpu().numpy().astype(np.float32)
     if not np.isfinite(out).all():
         raise ValueError(f"network {model} gave non-finite probabilities for this instance")
     return out
