@@ -462,8 +462,11 @@ def check_names_its_values(work: Path, eps: float, taus: list[float], tau: float
     client = MlflowClient(f"sqlite:///{work / 'mlflow.db'}")
     exp = client.get_experiment_by_name("vnrrt-smoke").experiment_id
     newest = ["attributes.start_time DESC"]
-    query = "tags.mlflow.runName = 'evaluation smoke'"
+    query = "attributes.run_name LIKE 'evaluation smoke%'"  # an ablation's: with its overrides
     (last,) = client.search_runs([exp], query, order_by=newest, max_results=1)
+    said = last.data.tags["overrides"]
+    assert (f"planner.eps={eps:g}" in said) == (eps != 0.01), said
+    assert last.info.run_name.startswith("evaluation smoke")
     names = "\n".join(last.data.metrics)
     slug = f"within_{pct.replace('%', 'pct')}_of_astar"
     assert f"{slug}/median_ms/m_vnrrt_star_tau{tau:g}" in names
