@@ -36,8 +36,11 @@ format: $(STAMP)  ## apply ruff fixes and formatting
 params: $(STAMP)  ## write params.yaml from conf/ (the default composition, as DVC does; validated)
 	$(BIN)/python -m vnrrt.params --out params.yaml
 
-repro: $(STAMP)  ## run the whole pipeline (dvc repro) at the default scale
+repro: $(STAMP)  ## run the whole pipeline (dvc repro) at the default scale; saved as experiment local-default
 	$(BIN)/dvc repro
+	@# this machine's own default run, the baseline an ablation is compared with (dvc exp diff)
+	$(BIN)/dvc exp save --force --name local-default \
+		|| echo "note: dvc exp save failed; compare an ablation with 'dvc exp diff HEAD <exp>'" >&2
 
 PLOTS_TEMPLATE := .dvc/tmp/plots_offline.html
 plots: $(STAMP)  ## the DVC plots as a page that renders offline: dvc_plots/index.html (Vega bundled)
