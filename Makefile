@@ -6,7 +6,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 export PATH := $(CURDIR)/$(BIN):$(PATH)
 
-.PHONY: help setup test test-all lint format params repro repro-cpu repro-cpu-budget-seed1 bench clean
+.PHONY: help setup test test-all lint format params repro plots repro-cpu repro-cpu-budget-seed1 bench clean
 
 help:  ## list the targets
 	@grep -E '^[a-z0-9-]+:.*## ' $(MAKEFILE_LIST) | awk -F':.*## ' '{printf "  %-10s %s\n", $$1, $$2}'
@@ -36,8 +36,16 @@ format: $(STAMP)  ## apply ruff fixes and formatting
 params: $(STAMP)  ## write params.yaml from conf/ (the default composition, as DVC does; validated)
 	$(BIN)/python -m vnrrt.params --out params.yaml
 
-repro: $(STAMP)  ## run the whole pipeline (dvc repro) at the default scale
+repro: $(STAMP)  ## run the whole pipeline (dvc repro) at the default scale; saved as experiment local-default
 	$(BIN)/dvc repro
+	@# this machine's own default run, the baseline an ablation is compared with (dvc exp diff)
+	$(BIN)/dvc exp save --force --name local-default \
+		|| echo "note: dvc exp save failed; compare an ablation with 'dvc exp diff HEAD <exp>'" >&2
+
+PLOTS_TEMPLATE := .dvc/tmp/plots_offline.html
+plots: $(STAMP)  ## the DVC plots as a page that renders offline: dvc_plots/index.html (Vega bundled)
+	$(BIN)/python -m vnrrt.viz.plots_page --out $(PLOTS_TEMPLATE)
+	$(BIN)/dvc plots show --html-template $(PLOTS_TEMPLATE)
 
 CPU_REPORTS := reports/cpu
 # The study's reports first, so that a run cut short still leaves them: the pipeline at

@@ -12,6 +12,7 @@ from pathlib import Path
 import yaml
 
 from tests.mlflow_server import Rest, metrics, params, tags
+from vnrrt.evaluation.paper_comparison.claims import verdict_text
 
 IMAGE = re.compile(r"!\[[^\]]*\]\(([^)\s]+)\)")
 LINK = re.compile(r"\]\((#/[^)\s]+)\)")
@@ -70,11 +71,11 @@ def check_claims(run: dict, summary: dict) -> None:
     m, t = metrics(run), tags(run)
     rows = summary["claims"]["rows"]
     verdicts = {k: v for k, v in t.items() if k.startswith("verdict/") and k.count("/") == 1}
-    assert sorted(verdicts.values()) == sorted(r["verdict"] for r in rows)
+    assert sorted(verdicts.values()) == sorted(verdict_text(r) for r in rows)  # the report's
     for row in rows:
         (key,) = [k for k, v in t.items() if k.startswith("claim/") and v == row["text"]]
         claim = key.removeprefix("claim/")
-        assert t[f"verdict/{claim}"] == row["verdict"]
+        assert t[f"verdict/{claim}"] == verdict_text(row)
         for reading, name in (("time_to_stop", "planning_time"), ("iterations", "iterations")):
             for stat in ("speedup", "ci_low", "ci_high"):
                 assert m[f"claims/{claim}/{name}/{stat}"] == row[reading][stat], (claim, stat)

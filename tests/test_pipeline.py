@@ -333,6 +333,32 @@ def test_metrics_and_plots_read_well(workdir):
     assert png[:4] == b"\x89PNG" and len(png) > 5000
 
 
+@pytest.mark.slow
+def test_the_plots_page_renders_offline_in_a_browser(workdir, tmp_path):
+    """`make plots`'s page (DVC's plots with the offline template, vnrrt.viz.plots_page)
+    loads nothing from the network and draws every plot in headless Chromium with the
+    network switched off."""
+    from tests.browser import Browser, chromium
+    from vnrrt.viz.plots_page import write_offline_page
+
+    if chromium() is None:
+        pytest.skip("chromium is not installed")
+    template = write_offline_page(tmp_path / "template.html")
+    out = tmp_path / "plots"
+    run(["dvc", "plots", "show", "--html-template", str(template), "-o", str(out)], workdir)
+    page = (out / "index.html").read_text()
+    assert "cdn.jsdelivr" not in page and "<script src=" not in page
+    n_plots = page.count("vegaEmbed('#")
+    with Browser() as b:
+        b.send("Network.enable", session=True)
+        b.send("Network.emulateNetworkConditions", session=True, offline=True, latency=0,
+               downloadThroughput=-1, uploadThroughput=-1)  # fmt: skip
+        b.goto((out / "index.html").as_uri())
+        drawn = "document.querySelectorAll('.vega-embed canvas, .vega-embed svg.marks').length"
+        b.wait_for(f"{drawn} >= {n_plots}")
+        assert n_plots >= 6 and b.js(drawn) >= n_plots
+
+
 NOT_OUTPUTS = ("mlflow.db", "mlartifacts/")  # the MLflow store: runs, not pipeline outputs
 
 
@@ -462,8 +488,11 @@ def check_names_its_values(work: Path, eps: float, taus: list[float], tau: float
     client = MlflowClient(f"sqlite:///{work / 'mlflow.db'}")
     exp = client.get_experiment_by_name("vnrrt-smoke").experiment_id
     newest = ["attributes.start_time DESC"]
-    query = "tags.mlflow.runName = 'evaluation smoke'"
+    query = "attributes.run_name LIKE 'evaluation smoke%'"  # an ablation's: with its overrides
     (last,) = client.search_runs([exp], query, order_by=newest, max_results=1)
+    said = last.data.tags["overrides"]
+    assert (f"planner.eps={eps:g}" in said) == (eps != 0.01), said
+    assert last.info.run_name.startswith("evaluation smoke")
     names = "\n".join(last.data.metrics)
     slug = f"within_{pct.replace('%', 'pct')}_of_astar"
     assert f"{slug}/median_ms/m_vnrrt_star_tau{tau:g}" in names

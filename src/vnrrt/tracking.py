@@ -12,7 +12,9 @@ evaluation runs.
   repository's ``mlartifacts`` again, so a copy never writes into the original.
 * **Experiments**: one per scale (``logger.experiment``, ``vnrrt-<scale>`` by default);
   runs named ``<network> <scale>``, ``predict <scale>``, ``ideas <scale>`` and ``evaluation
-  <scale>``, tagged with kind, scale, git commit, DVC stage and experiment; params spelled
+  <scale>``, followed by an ablation's overrides (``evaluation quick tau=0.7``:
+  :func:`run_name`), tagged with kind, scale, git commit, DVC stage and experiment, and the
+  overrides in full (``overrides``: ``planner.tau=0.7``, or ``none``); params spelled
   as in YAML (:func:`param_text`). What each run holds: ``vnrrt.training.runs``,
   ``vnrrt.predict.runs``, ``vnrrt.evaluation.*.runs``; lineage between them:
   :mod:`vnrrt.lineage`.
@@ -203,8 +205,46 @@ def run_tags(kind: str, scale: str, **extra: str) -> dict[str, str]:
         "dvc_stage": env.get("DVC_STAGE", "none"),
         "dvc_experiment": env.get("DVC_EXP_NAME", "none"),
         "dvc_baseline": env.get("DVC_EXP_BASELINE_REV", "none"),
+        "overrides": " ".join(f"{k}={v}" for k, v in overrides().items()) or "none",
         **extra,
     }
+
+
+def overrides(params: str | Path = "params.yaml") -> dict[str, str]:
+    """The settings of the run's ``params`` file that differ from ``conf/``'s default
+    composition at the same scale (what ``dvc exp run -S ...`` changed), as ``{"a.b":
+    text}`` in key order; ``{}`` where the file is missing or unreadable (a library call)."""
+    path = Path(params).resolve()
+    stat = path.stat() if path.is_file() else None
+    return dict(_overrides(str(path), stat and (stat.st_mtime_ns, stat.st_size)))
+
+
+@functools.cache
+def _overrides(params: str, version) -> tuple[tuple[str, str], ...]:
+    """:func:`overrides` of one version (mtime, size) of the file, composed once."""
+    from vnrrt.config import ConfigError, compose, load_params
+
+    try:
+        ran = flat_params(load_params(params))
+        default = flat_params(compose([f"scale={ran.get('scale.name', 'quick')}"]))
+    except (ConfigError, OSError):
+        return ()
+    return tuple((k, v) for k, v in ran.items() if default.get(k) != v)
+
+
+def override_text(changed: dict[str, str]) -> str:
+    """``changed`` (:func:`overrides`) as a run name's suffix: ``tau=0.7 eps=0.02``, each
+    setting by its last key unless two share it (then in full); ``""`` for none."""
+    last = [k.rsplit(".", 1)[-1] for k in changed]
+    names = [k if last.count(k.rsplit(".", 1)[-1]) > 1 else k.rsplit(".", 1)[-1] for k in changed]
+    return " ".join(f"{n}={v}" for n, v in zip(names, changed.values(), strict=True))
+
+
+def run_name(base: str, params: str | Path = "params.yaml") -> str:
+    """``base`` (e.g. ``evaluation quick``) followed by the run's overrides, if any: an
+    ablation's runs read ``evaluation quick tau=0.7`` beside the default's."""
+    suffix = override_text(overrides(params))
+    return f"{base} {suffix}" if suffix else base
 
 
 def param_text(value) -> str:

@@ -67,7 +67,8 @@ def log_predict(logger: tracking.LoggerConfig, scale: str, out: dict, files: dic
     tags |= lineage.content_tag("predict.json", files["predict.json"])
     trained = [lineage.training_lineage(n, p) for n, p in sorted(trainings.items())]
     mlflow.set_tracking_uri(uri)
-    with mlflow.start_run(experiment_id=exp, run_name=f"predict {scale}", tags=tags) as run:
+    name = tracking.run_name(f"predict {scale}")
+    with mlflow.start_run(experiment_id=exp, run_name=name, tags=tags) as run:
         run_id = run.info.run_id
         mlflow.log_params(predict_params(out))
         mlflow.log_metrics(predict_metrics(out))

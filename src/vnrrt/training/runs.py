@@ -85,6 +85,7 @@ def start_run(logger_cfg: tracking.LoggerConfig, scale: str, network: str, recor
         logger_cfg, network, scale, fingerprint=record["fingerprint"], **extra
     )
     name = f"{network} {scale}" + ("" if budget is None else f" budget {int(budget)}")
+    name = tracking.run_name(name)
     logger = instantiate(logger_cfg.lightning, run_name=name, tracking_uri=uri, tags=tags)
     logger.log_hyperparams(run_params(settings, record, budget))
     counts = {k: v for k, v in record["describe"].items() if k.startswith("params_")}

@@ -30,6 +30,22 @@ SHARES = ("mass_endpoints", "mass_interior", "mass_path")
 COMPATIBLE, CONTRADICTS = "compatible with the paper's data", "contradicts the paper's data"
 
 
+def improvement(c: dict, lo: str = "ci_low", hi: str = "ci_high", mid: str = "speedup") -> str:
+    """A reading's improvement (ratio - 1) with its interval, as the report and the
+    dashboard show it: ``+12.3% [+1.0%, +25.0%]``."""
+    return f"{c[mid] - 1:+.1%} [{c[lo] - 1:+.1%}, {c[hi] - 1:+.1%}]"
+
+
+def verdict_text(row: dict) -> str:
+    """A claim's verdict in the report's words (the dashboard's too): with the iterations'
+    verdict where it differs from the time reading's (``no clear effect; on iterations:
+    reproduced``), and ``different map: not comparable (...)`` off the comparable column."""
+    text, it = row["verdict"], row.get("iterations")
+    if row.get("time_to_stop") and it and it["verdict"] != text:
+        text = f"{text}; on iterations: {it['verdict']}"
+    return text if row["comparable"] else f"different map: not comparable ({text})"
+
+
 def mask_shares(table: pd.DataFrame) -> dict:
     """``{stop: {key: {map_set: {mass_endpoints, mass_interior, mass_path, fallback_rate,
     instances}}}}`` for every configuration with a heatmap: the shares averaged over

@@ -15,7 +15,8 @@ import math
 from dataclasses import dataclass
 
 from vnrrt.evaluation.keys import ConfigKey, is_informed, label, sort_texts
-from vnrrt.evaluation.paper_comparison.claims import CONTRADICTS
+from vnrrt.evaluation.paper_comparison.claims import CONTRADICTS, verdict_text
+from vnrrt.evaluation.paper_comparison.claims import improvement as _imp
 from vnrrt.evaluation.paper_comparison.disclosure import (
     mask_section,
     networks_scale_table,
@@ -145,11 +146,6 @@ def optima_table(paper: dict, optima: dict) -> str:
     return "\n".join(lines)
 
 
-def _imp(c: dict, lo: str = "ci_low", hi: str = "ci_high", mid: str = "speedup") -> str:
-    """An improvement (ratio - 1) with its interval: ``+12.3% [+1.0%, +25.0%]``."""
-    return f"{c[mid] - 1:+.1%} [{c[lo] - 1:+.1%}, {c[hi] - 1:+.1%}]"
-
-
 def claims_table(claims: dict) -> str:
     """The paper's quoted claims: the paper's value and its interval from its own data, ours
     read on time (the verdict), on time with the network's inference, and on iterations, the
@@ -167,13 +163,9 @@ def claims_table(claims: dict) -> str:
         if t is None:
             cells = ["no data"] * 4 + ["no data", "—"]
         else:
-            verdict = (
-                r["verdict"]
-                if r["comparable"]
-                else f"different map: not comparable ({r['verdict']})"
-            )
             cells = [_imp(t), _imp(t, "rom_ci_low", "rom_ci_high", "ratio_of_means"),
-                     _imp(total) if total else "—", _imp(it), verdict, r["paper_data"]]  # fmt: skip
+                     _imp(total) if total else "—", _imp(it), verdict_text(r),
+                     r["paper_data"]]  # fmt: skip
         tm = r["testability"]
         cells.append(
             "yes" if tm["testable"] else f"no: not testable with this network ({tm['why']})"

@@ -27,7 +27,12 @@ Tags: ``verdict/<claim>`` (the claim's verdict), ``verdict/<claim>/<reading>``,
 from __future__ import annotations
 
 from vnrrt.evaluation.keys import ConfigKey
-from vnrrt.evaluation.paper_comparison.claims import COMPATIBLE, CONTRADICTS
+from vnrrt.evaluation.paper_comparison.claims import (
+    COMPATIBLE,
+    CONTRADICTS,
+    improvement,
+    verdict_text,
+)
 from vnrrt.names import stop_name, stop_slug
 from vnrrt.tracking import metric_name
 
@@ -108,7 +113,7 @@ def claim_tags(rows: list[dict]) -> dict[str, str]:
     out = {}
     for row in rows:
         c = claim_key(row)
-        out[f"verdict/{c}"] = row["verdict"]
+        out[f"verdict/{c}"] = verdict_text(row)
         for reading, name in READINGS.items():
             if row.get(reading):
                 out[f"verdict/{c}/{name}"] = row[reading]["verdict"]
@@ -133,15 +138,15 @@ def verdict_table(rows: list[dict]) -> list[str]:
         testable = "yes" if row["testability"]["testable"] else "no"
         data = PAPER_DATA.get(row["paper_data"], "no data")
         lines.append(
-            f"| {row['text']} | {_ci(t)} | {_ci(it)} | **{row['verdict']}** | {data} | {testable} |"
+            f"| {row['text']} | {_ci(t)} | {_ci(it)} | **{verdict_text(row)}** | {data} | "
+            f"{testable} |"
         )
     return lines
 
 
 def _ci(reading: dict | None) -> str:
-    if not reading:
-        return "no data"
-    return f"{reading['speedup']:.2f}x [{reading['ci_low']:.2f}, {reading['ci_high']:.2f}]"
+    """A reading as the report shows it (improvement in percent with its CI)."""
+    return improvement(reading) if reading else "no data"
 
 
 def describe(summary: dict, scale: str, links: list[str], figure: str | None) -> str:
@@ -151,8 +156,9 @@ def describe(summary: dict, scale: str, links: list[str], figure: str | None) ->
     level = f"{100 * claims['corrected_level']:.4g}%"
     parts = [
         f"**The paper comparison at scale `{scale}`**: each claim the paper quotes, tested on "
-        "this run's trials. Speed-up: geometric mean over instances of median(baseline) / "
-        f"median(planner), with its {level} CI (Bonferroni over {claims['claims']} claims); "
+        "this run's trials. Improvement (as in the report): the geometric mean over instances "
+        f"of median(baseline) / median(planner), minus 1, with its {level} CI (Bonferroni "
+        f"over {claims['claims']} claims); "
         f"the stop rules of the claims: {stop_name('initial', summary['eps'])}, "
         f"{stop_name('optimal', summary['eps'])}. The full report: `paper_comparison.html` "
         "(figures inline) or `paper_comparison.md` under Artifacts.",

@@ -62,7 +62,7 @@ def log_evaluation(logger: tracking.LoggerConfig, scale: str, params: dict,
     used = {f"{n.removesuffix('.json')}_run": r.info.run_id for n, r in found.items() if r}
     own = training_tags(trainings) | run_text.claim_tags(summary["claims"]["rows"]) | used
     mlflow.set_tracking_uri(uri)
-    name = f"evaluation {scale}"
+    name = tracking.run_name(f"evaluation {scale}")
     with mlflow.start_run(experiment_id=exp, run_name=name, tags=tags | own) as parent:
         run_id = parent.info.run_id
         mlflow.log_params(tracking.flat_params(params))

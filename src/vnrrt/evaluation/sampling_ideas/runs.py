@@ -41,7 +41,8 @@ def log_ideas(
     extra = {}
     for path in (p for p in files if p.suffix == ".json"):
         extra |= lineage.content_tag(path.name, path)
-    with mlflow.start_run(experiment_id=exp, run_name=f"ideas {scale}", tags=tags | extra) as run:
+    name = tracking.run_name(f"ideas {scale}")
+    with mlflow.start_run(experiment_id=exp, run_name=name, tags=tags | extra) as run:
         mlflow.log_params(tracking.flat_params(params))
         mlflow.log_metrics(headline_metrics(summary))
         cells = dict.fromkeys((r["regime"], r["configuration"]) for r in summary["cells"])
