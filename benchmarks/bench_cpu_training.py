@@ -112,7 +112,7 @@ def data_rates(max_workers: int) -> None:
 
 def learning(variants: list[str], minutes: float, rates: dict[str, float]) -> None:
     """Part 3: each variant trained for ``minutes`` worth of steps, then tested."""
-    from vnrrt.training.stage import run_train
+    from vnrrt.pipeline.training import run_train
 
     print(
         f"\n3. learning per CPU-minute: {minutes:g} min of steps each, quick shards, batch {BATCH}"

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from omegaconf import OmegaConf
 
-from vnrrt.cli import main
+from vnrrt.cli.main import main
 from vnrrt.config import CONF_DIR, section
 from vnrrt.data.build import build_shard
 from vnrrt.data.build_named import build_named_maps

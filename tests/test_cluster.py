@@ -1,4 +1,4 @@
-"""Shard jobs as Hydra multiruns (vnrrt.multirun) through the joblib launcher and through
+"""Shard jobs as Hydra multiruns (vnrrt.pipeline.multirun) through the joblib launcher and through
 submitit on a real one-node SLURM cluster: the shard files are byte for byte those of stage
 ``shard@<id>``, and ``dvc commit`` makes ``dvc repro`` skip them."""
 
@@ -54,14 +54,26 @@ def scratch(tmp_path, repo) -> tuple[Path, dict]:
         DVC_NO_ANALYTICS="1",
     )
     run(["dvc", "init", "--no-scm", "-q"], tmp_path, env)
-    run([sys.executable, "-m", "vnrrt.params", *SMOKE, "--out", "params.yaml"], tmp_path, env)
+    run(
+        [sys.executable, "-m", "vnrrt.pipeline.params", *SMOKE, "--out", "params.yaml"],
+        tmp_path,
+        env,
+    )
     return tmp_path, env
 
 
 def multirun(work: Path, env: dict, *overrides: str) -> str:
-    """``python -m vnrrt.multirun -m`` over the smoke shards, one core per job."""
+    """``python -m vnrrt.pipeline.multirun -m`` over the smoke shards, one core per job."""
     ids = ",".join(map(str, SHARDS))
-    cmd = [sys.executable, "-m", "vnrrt.multirun", "-m", "+stage=shard", f"+part={ids}", *SMOKE]
+    cmd = [
+        sys.executable,
+        "-m",
+        "vnrrt.pipeline.multirun",
+        "-m",
+        "+stage=shard",
+        f"+part={ids}",
+        *SMOKE,
+    ]
     return run([*cmd, "workers=1", f"hydra.sweep.dir={SWEEP}", *overrides], work, env)
 
 

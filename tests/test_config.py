@@ -15,8 +15,8 @@ from vnrrt.config import (
 )
 from vnrrt.data.config import LabelsConfig, ScaleConfig
 from vnrrt.maps.config import DataConfig
-from vnrrt.params import main as params_main
-from vnrrt.validate import validate_config
+from vnrrt.pipeline.params import main as params_main
+from vnrrt.pipeline.validate import validate_config
 
 
 def test_committed_params_yaml_equals_the_default_composition(repo):

@@ -144,7 +144,7 @@ def test_manifest_counts_checksums_and_tamper_detection(shard_dir, tmp_path):
 
 
 def test_an_interrupted_write_leaves_neither_file_nor_temp(tmp_path):
-    from vnrrt.io import atomic_write_bytes
+    from vnrrt.infra.io import atomic_write_bytes
 
     target = tmp_path / "out.bin"
 

@@ -11,19 +11,19 @@ from vnrrt.data.instances import EvalInstance
 from vnrrt.evaluation import sampling as sampling_module
 from vnrrt.evaluation.config import Configurations
 from vnrrt.evaluation.keys import ConfigKey
-from vnrrt.evaluation.paper_comparison.claims import (
+from vnrrt.evaluation.protocol import configurations
+from vnrrt.evaluation.stats import verdict
+from vnrrt.evaluation.trials import run_trials
+from vnrrt.search import any_angle_path, astar, path_vertices
+from vnrrt.studies.paper_comparison.claims import (
     COMPATIBLE,
     CONTRADICTS,
     claim_boot,
     compatibility,
 )
-from vnrrt.evaluation.paper_comparison.claims import (
+from vnrrt.studies.paper_comparison.claims import (
     testability as masked_rule,
 )
-from vnrrt.evaluation.protocol import configurations
-from vnrrt.evaluation.stats import verdict
-from vnrrt.evaluation.trials import run_trials
-from vnrrt.search import any_angle_path, astar, path_vertices
 
 
 @pytest.mark.parametrize(

@@ -15,14 +15,6 @@ from vnrrt.data.instances import EvalInstance
 from vnrrt.evaluation.config import Configurations, OracleConfig, RegimeConfig
 from vnrrt.evaluation.keys import ConfigKey
 from vnrrt.evaluation.oracles import OracleSource, blend, dilute, oracle_heatmap
-from vnrrt.evaluation.sampling_ideas.design import (
-    evaluation_keys,
-    family_members,
-    protocol_settings,
-    regime_cells,
-    selection_keys,
-    split_instances,
-)
 from vnrrt.evaluation.sources import (
     ORACLE_KINDS,
     allowed_cells,
@@ -35,6 +27,14 @@ from vnrrt.maps.config import DataConfig
 from vnrrt.maps.generate import generate_map, map_rng
 from vnrrt.planners import PlannerConfig, plan
 from vnrrt.search import any_angle_path, astar, path_vertices
+from vnrrt.studies.sampling_ideas.design import (
+    evaluation_keys,
+    family_members,
+    protocol_settings,
+    regime_cells,
+    selection_keys,
+    split_instances,
+)
 
 # a protocol with a Steer step of 7 px: no grid cell below repeats it
 ELSEWHERE = protocol_settings(PlannerConfig(eta=7.0))

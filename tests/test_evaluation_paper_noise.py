@@ -5,12 +5,12 @@ import math
 
 import pytest
 
-from vnrrt.evaluation.paper_comparison.paper_noise import (
+from vnrrt.studies.paper_comparison.paper_noise import (
     claim_interval,
     ratio_interval,
     simulated_interval,
 )
-from vnrrt.evaluation.paper_tables import load_paper_tables
+from vnrrt.studies.paper_tables import load_paper_tables
 
 
 def test_a_precise_ratio_has_a_narrow_interval_around_it():

@@ -6,17 +6,17 @@ import pandas as pd
 import yaml
 
 from vnrrt.evaluation.config import StatsConfig
-from vnrrt.evaluation.paper_comparison.paper_noise import ratio_interval
-from vnrrt.evaluation.paper_comparison.report import (
+from vnrrt.evaluation.table import COLUMNS, conform
+from vnrrt.studies.paper_comparison.paper_noise import ratio_interval
+from vnrrt.studies.paper_comparison.report import (
     MetricSettings,
     ReportInputs,
     build_report,
     cell,
     networks_section,
 )
-from vnrrt.evaluation.paper_comparison.summary import analyze
-from vnrrt.evaluation.paper_tables import load_paper_tables
-from vnrrt.evaluation.table import COLUMNS, conform
+from vnrrt.studies.paper_comparison.summary import analyze
+from vnrrt.studies.paper_tables import load_paper_tables
 
 METRICS = MetricSettings(radius=3.0, tau=0.5, ap_radius=1.0, endpoint_radius=3.0)
 

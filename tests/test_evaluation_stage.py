@@ -19,10 +19,10 @@ from vnrrt.data.heatmaps import part_file, part_rows, write_heatmaps
 from vnrrt.data.instances import Instances
 from vnrrt.data.manifest import build_manifest
 from vnrrt.data.shards import shard_file
-from vnrrt.evaluation.paper_comparison.stage import run_evaluate, run_report
-from vnrrt.evaluation.stage import run_instances, run_trials_part
 from vnrrt.evaluation.table import SEEDED_COLUMNS, TableError, merge_parts, read_table
 from vnrrt.maps.config import DataConfig
+from vnrrt.pipeline.evaluation import run_instances, run_trials_part
+from vnrrt.pipeline.paper_comparison import run_evaluate, run_report
 from vnrrt.search import path_mask
 
 NETS = (("vertexnet", "vertex"), ("nrrtnet", "path"))
@@ -271,8 +271,8 @@ def _returned_folder(cfg, out: Path) -> Path:
     """What a GPU run (scripts/gpu/paper_network.sh) returns for ``cfg``'s instances, with the
     prediction parts' oracle heatmaps as the paper networks' heatmaps."""
     from vnrrt.data.heatmaps import read_parts
-    from vnrrt.gpu.returned import NETWORKS, write_returned_heatmaps
-    from vnrrt.io import sha256
+    from vnrrt.data.returned import NETWORKS, write_returned_heatmaps
+    from vnrrt.infra.io import sha256
 
     files = read_parts(cfg.paths.heatmaps, [0, 1])
     maps = {paper: files["maps"][net] for paper, net in NETWORKS.items()}
@@ -296,7 +296,7 @@ def test_the_gpu_networks_are_heatmap_sources_of_the_trials(cfg, repo, tmp_path)
     reader) are sampled by NRRT*, VNRRT* and M-VNRRT* at planner.tau beside the trained
     networks; the heatmap masses are those of the returned maps. A returned folder made for
     other instances is refused, naming it."""
-    from vnrrt.gpu.returned import ReturnedError
+    from vnrrt.data.returned import ReturnedError
 
     gpu = copy.deepcopy(cfg)
     gpu.eval.gpu = True
@@ -315,9 +315,9 @@ def test_the_gpu_networks_are_heatmap_sources_of_the_trials(cfg, repo, tmp_path)
     np.testing.assert_allclose(paper[both], net[both], rtol=1e-6)
     assert per["vnrrt_star[paper_vertexnet]"].notna().all()
     from vnrrt.config import section
-    from vnrrt.evaluation.paper_comparison.disclosure import networks_scale_table
-    from vnrrt.evaluation.paper_comparison.stage import gpu_trainings
-    from vnrrt.paths import Paths
+    from vnrrt.config.paths import Paths
+    from vnrrt.pipeline.paper_comparison import gpu_trainings
+    from vnrrt.studies.paper_comparison.disclosure import networks_scale_table
 
     rows = gpu_trainings(section(gpu, "paths", Paths))  # the report's networks table
     table = networks_scale_table(rows, "smoke", "ResNet34 U-Net")

@@ -7,7 +7,6 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from vnrrt.evaluation.paper_tables import load_paper_tables
 from vnrrt.evaluation.stats import (
     bootstrap_means,
     compare,
@@ -15,6 +14,7 @@ from vnrrt.evaluation.stats import (
     summarize,
     verdict,
 )
+from vnrrt.studies.paper_tables import load_paper_tables
 
 
 def test_summary_matches_hand_computation():

@@ -1,5 +1,5 @@
-"""The GPU run of issue 27 (``scripts/gpu/paper_network.sh``, :mod:`vnrrt.gpu`) end to end on
-the CPU with a tiny budget and tiny sizes, under an import blocker for what the GPU machine
+"""The GPU run of issue 27 (``scripts/gpu/paper_network.sh``, :mod:`vnrrt.pipeline.gpu`) end to
+end on the CPU with a tiny budget and tiny sizes, under an import blocker for what the GPU machine
 lacks; the returned files read back through the pipeline's reader; the reader's checks."""
 
 from __future__ import annotations
@@ -17,12 +17,12 @@ import torch
 
 from tests.train_helpers import SMALL
 from vnrrt.data.heatmaps import read_heatmaps, write_heatmaps
+from vnrrt.data.returned import NETWORKS, Instances, ReturnedError, check_limits, read_returned
 from vnrrt.data.shards import shard_file
 from vnrrt.evaluation.instances import build_instances
-from vnrrt.gpu.bundle import make_bundle
-from vnrrt.gpu.predict import metric_settings
-from vnrrt.gpu.returned import NETWORKS, Instances, ReturnedError, check_limits, read_returned
-from vnrrt.io import sha256
+from vnrrt.infra.io import sha256
+from vnrrt.pipeline.gpu.bundle import make_bundle
+from vnrrt.pipeline.gpu.predict import metric_settings
 from vnrrt.predict.batch import heatmap_metrics
 
 BLOCKED = ("hydra", "omegaconf", "mlflow", "dvc")  # not installed on the GPU machine
@@ -73,7 +73,7 @@ def returned(bundle, blocked_env, repo) -> Path:
 
 def test_the_script_runs_without_what_the_gpu_machine_lacks(returned, blocked_env):
     # the run above succeeded under the blocker; the blocker does block, vnrrt's imports too
-    for module in ("omegaconf", "vnrrt.training.stage"):
+    for module in ("omegaconf", "vnrrt.pipeline.training"):
         proc = subprocess.run([sys.executable, "-c", f"import {module}"], env=blocked_env,
                               capture_output=True, text=True)  # fmt: skip
         assert proc.returncode != 0 and "(blocked)" in proc.stderr, module
@@ -243,7 +243,7 @@ def test_the_reader_refuses_heatmaps_of_another_instances_file(returned, bundle,
     ],
 )
 def test_bad_arguments_are_one_line_errors(bundle, tmp_path, capsys, args, message):
-    from vnrrt.gpu.run import main
+    from vnrrt.pipeline.gpu.run import main
 
     base = ["--device", "cpu", "--budget", "10", "--bundle", str(bundle / "bundle"),
             "--out", str(tmp_path / "out")]  # fmt: skip
@@ -254,7 +254,7 @@ def test_bad_arguments_are_one_line_errors(bundle, tmp_path, capsys, args, messa
 
 
 def test_a_missing_bundle_is_named(tmp_path, capsys):
-    from vnrrt.gpu.run import main
+    from vnrrt.pipeline.gpu.run import main
 
     assert main(["--device", "cpu", "--budget", "10", "--bundle", str(tmp_path),
                  "--out", str(tmp_path / "out")]) == 2  # fmt: skip
@@ -262,7 +262,7 @@ def test_a_missing_bundle_is_named(tmp_path, capsys):
 
 
 def test_instances_beyond_the_return_limits_fail_before_any_work():
-    from vnrrt.gpu.returned import heatmap_parts
+    from vnrrt.data.returned import heatmap_parts
 
     assert heatmap_parts(205, 200, 2) == 3  # the CPU scale's instances: 31 MiB in 3 parts
     with pytest.raises(ReturnedError, match="use an instances file with fewer instances"):
@@ -271,7 +271,7 @@ def test_instances_beyond_the_return_limits_fail_before_any_work():
 
 def test_an_evaluation_instance_on_a_training_map_is_refused(small_data, bundle):
     from vnrrt.data.reader import TRAIN, Shard
-    from vnrrt.gpu.data import check_heldout
+    from vnrrt.pipeline.gpu.data import check_heldout
 
     files = [shard_file(small_data / "shards", s) for s in (0, 1)]
     instances = Instances(bundle / "instances.npz")
@@ -286,7 +286,7 @@ def test_an_evaluation_instance_on_a_training_map_is_refused(small_data, bundle)
 
 
 def test_config_nodes_are_built_without_hydra():
-    from vnrrt.gpu.plan import build
+    from vnrrt.pipeline.gpu.plan import build
 
     opt = build({"_target_": "torch.optim.AdamW", "_partial_": True, "lr": 0.1})
     assert opt.func is torch.optim.AdamW and opt.keywords == {"lr": 0.1}
@@ -296,7 +296,7 @@ def test_config_nodes_are_built_without_hydra():
 
 
 def test_compiling_pays_only_when_its_time_comes_back_and_the_loader_keeps_up():
-    from vnrrt.gpu.probe import compile_pays
+    from vnrrt.pipeline.gpu.probe import compile_pays
 
     # 1.5x faster steps after 30 s of compiling: (T - 30) * 150 > T * 100 iff T > 90 s
     assert not compile_pays(100.0, 150.0, 30.0, loader=1e4, workers=4, seconds=80.0)
@@ -306,7 +306,7 @@ def test_compiling_pays_only_when_its_time_comes_back_and_the_loader_keeps_up():
 
 
 def test_planned_steps_end_on_a_validation():
-    from vnrrt.gpu.train import STEP_SLACK, planned_steps
+    from vnrrt.pipeline.gpu.train import STEP_SLACK, planned_steps
 
     for rate, seconds, batch in ((100.0, 10.0, 8), (3000.0, 90.0, 512), (1.0, 1.0, 4)):
         steps, interval = planned_steps(rate, seconds, batch)

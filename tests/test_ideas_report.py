@@ -2,7 +2,7 @@
 in which regime cell (an interval containing 1 is never a win) and which cells have runs
 stopped by the budget."""
 
-from vnrrt.evaluation.sampling_ideas.report import (
+from vnrrt.studies.sampling_ideas.report import (
     _winner_finding,
     budget_table,
     cells_by_winner,

@@ -67,7 +67,7 @@ def test_a_signal_ends_a_shard_stage_within_seconds_and_leaves_nothing(tmp_path,
 
 SLOW_START = """
 import multiprocessing.process as mpp, time
-from vnrrt.parallel import parallel_map
+from vnrrt.infra.parallel import parallel_map
 
 start = mpp.BaseProcess.start
 

@@ -124,7 +124,7 @@ def test_an_older_checkpoint_loads_only_beside_its_sha256(trained, tmp_path):
 
 
 def test_non_finite_weights_are_refused_and_predict_writes_nothing(trained, tmp_path, capsys):
-    from vnrrt.cli import main
+    from vnrrt.cli.main import main
 
     ckpt = read_checkpoint(trained / "models" / "vertexnet.ckpt")
     ckpt["state_dict"]["net.head.weight"][0, 0, 0, 0] = float("nan")

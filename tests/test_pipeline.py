@@ -27,6 +27,7 @@ from tests import mlflow_review as review
 from tests.conftest import copy_dvc_files, copy_pipeline
 from tests.mlflow_server import Rest, TrackingServer, metrics, params, tags
 from vnrrt.config import compose, dump, section
+from vnrrt.config.paths import Paths, stage_outputs
 from vnrrt.data.build import build_shard
 from vnrrt.data.config import LabelsConfig
 from vnrrt.data.heatmaps import read_heatmaps
@@ -34,7 +35,6 @@ from vnrrt.data.manifest import verify_manifest
 from vnrrt.data.shards import shard_file
 from vnrrt.evaluation.table import SEEDED_COLUMNS, merge_parts
 from vnrrt.maps.config import DataConfig
-from vnrrt.paths import Paths, stage_outputs
 
 SHARDS = Path("data/smoke/shards")
 # The session's pipeline runs at these values rather than conf/'s defaults, so that every test
@@ -346,8 +346,10 @@ def _stage_of(argv: list[str]) -> tuple[str, str | None]:
 
 def stages_writing_their_outputs(workdir: Path) -> set[str]:
     """The stages whose processes the write audit recorded, each checked to have created or
-    changed exactly the files of its outputs in ``dvc.yaml`` (:func:`vnrrt.paths.stage_outputs`,
-    files under an output folder included), besides the MLflow store."""
+    changed exactly the files of its outputs in ``dvc.yaml``
+    (:func:`vnrrt.config.paths.stage_outputs`, files under an output folder included), besides
+    the MLflow
+    store."""
     cfg = yaml.safe_load((workdir / "params.yaml").read_text())
     paths = section(cfg, "paths", Paths)
     entries = [json.loads(line) for line in write_log(workdir).read_text().splitlines()]
@@ -377,7 +379,7 @@ def test_the_committed_tables_recompute_both_reports_byte_for_byte(workdir, tmp_
     bundle alone the same statistics, reports and headline metrics as the stages did."""
     bundle, out = tmp_path / "results", tmp_path / "again"
     env = {"VNRRT_WRITE_LOG": ""}  # not a stage
-    cmd = [sys.executable, "-m", "vnrrt.evaluation.recompute"]
+    cmd = [sys.executable, "-m", "vnrrt.pipeline.recompute"]
     run([*cmd, "export", "--params", "params.yaml", "--out", str(bundle)], workdir, **env)
     assert (bundle / "trials.csv.gz").stat().st_size > 1000 and (bundle / "README.md").is_file()
     run([*cmd, "run", "--bundle", str(bundle), "--out", str(out)], workdir, **env)
@@ -552,7 +554,7 @@ def test_predict_and_trial_parts_as_multirun_jobs_write_the_stage_files(workdir,
     job = [
         sys.executable,
         "-m",
-        "vnrrt.multirun",
+        "vnrrt.pipeline.multirun",
         "-m",
         *SMOKE,  # the workspace's values (as committed: the session's, at its seed)
         seed_override(workdir),
@@ -600,7 +602,10 @@ def test_a_stage_runs_as_the_readme_says(workdir, repo):
         pytest.skip("not running inside a virtual environment")
     env = {k: v for k, v in os.environ.items() if k != "MLFLOW_TRACKING_URI"}
     env["PATH"] = "/usr/bin:/bin"  # a fresh shell: no project interpreter on PATH
-    cmd = f". {venv}/bin/activate && dvc repro -f -s named_maps && python -m vnrrt.params --help"
+    cmd = (
+        f". {venv}/bin/activate && dvc repro -f -s named_maps"
+        " && python -m vnrrt.pipeline.params --help"
+    )
     proc = subprocess.run(
         ["bash", "-c", cmd], cwd=workdir, env=env, capture_output=True, text=True, check=False
     )

@@ -1,5 +1,6 @@
-"""Reports as MLflow artifacts (vnrrt.report_artifacts), the MLflow names of the study
-(vnrrt.names slugs, the evaluation run's claim keys) and the lineage helpers (vnrrt.lineage):
+"""Reports as MLflow artifacts (vnrrt.tracking.report_artifacts), the MLflow names of the study
+(vnrrt.names slugs, the evaluation run's claim keys) and the lineage helpers
+(vnrrt.tracking.lineage):
 figures logged under the paths a report uses, links swapped for UI links, the HTML with its
 figures inline, DVC's hash as a dataset digest."""
 
@@ -11,10 +12,10 @@ from pathlib import Path
 import pytest
 from mlflow import MlflowClient
 
-from vnrrt import lineage
-from vnrrt.evaluation.paper_comparison.run_text import claim_key, planner_key
 from vnrrt.names import map_set_slug, stop_slug
-from vnrrt.report_artifacts import figure_paths, log_report, to_html, with_links
+from vnrrt.studies.paper_comparison.run_text import claim_key, planner_key
+from vnrrt.tracking import lineage
+from vnrrt.tracking.report_artifacts import figure_paths, log_report, to_html, with_links
 
 PNG = base64.b64decode(
     "iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAYAAAAfFcSJAAAADUlEQVR42mNk+M9QDwADhgGAWjR9awAAAABJRU5ErkJggg=="

@@ -60,7 +60,7 @@ def test_a_stage_that_succeeds_exits_0(work):
 def test_an_internal_error_of_a_stage_exits_3_with_its_traceback(work):
     script = work / "stages" / "broken.py"
     script.write_text(
-        "from vnrrt.stage_cli import stage_main\n\n"
+        "from vnrrt.cli.stage import stage_main\n\n"
         "def broken(cfg):\n    raise RuntimeError('boom')\n\n"
         "stage_main('validate', broken, 'a stage with a bug')\n"
     )
@@ -82,7 +82,7 @@ def test_errors_are_classed_as_input_or_internal(capsys):
 
     from mlflow.exceptions import MlflowException
 
-    from vnrrt.stage_cli import EXIT_INPUT, is_input_error, run_reporting
+    from vnrrt.cli.stage import EXIT_INPUT, is_input_error, run_reporting
 
     for err in (ValueError("x"), FileNotFoundError("x"), zipfile.BadZipFile("x"),
                 MlflowException("store down")):  # fmt: skip

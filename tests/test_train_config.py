@@ -10,7 +10,7 @@ from tests.train_helpers import SMALL
 from vnrrt.config import CONF_DIR, compose
 from vnrrt.data.datamodule import ShardDataModule
 from vnrrt.model.module import VertexNetModule
-from vnrrt.training.callbacks import LogProgress, progress_callback
+from vnrrt.pipeline.callbacks import LogProgress, progress_callback
 from vnrrt.training.train import cpu_bf16_flags, resolve_precision
 
 TRAINERS = sorted(p.stem for p in (CONF_DIR / "trainer").glob("*.yaml"))

@@ -18,8 +18,8 @@ from vnrrt.model.checkpoint import (
     seal,
 )
 from vnrrt.model.metrics import VertexRecall
-from vnrrt.training.callbacks import LogProgress
-from vnrrt.training.stage import run_train as train
+from vnrrt.pipeline.callbacks import LogProgress
+from vnrrt.pipeline.training import run_train as train
 
 
 def test_fast_dev_run_of_the_real_smoke_config(smoke_data, tmp_path):
@@ -110,7 +110,7 @@ def test_stale_running_runs_of_the_stage_are_marked_killed(small_data, tmp_path,
     """A SIGKILLed training cannot end its MLflow run; the next run of that stage does."""
     from mlflow import MlflowClient
 
-    from vnrrt import tracking
+    from vnrrt.tracking import store as tracking
 
     monkeypatch.setenv("DVC_STAGE", "train@vertexnet")
     cfg = small_cfg(small_data, tmp_path, *QUICK, "logger.enabled=true", "logger.log_model=false")

@@ -17,9 +17,9 @@ from vnrrt.data.instances import Instances
 from vnrrt.evaluation.instances import build_instances
 from vnrrt.maps.render import render_instance
 from vnrrt.model.checkpoint import load_network
+from vnrrt.pipeline.predict import run_predict_metrics, run_predict_part
 from vnrrt.predict import heatmap
 from vnrrt.predict.batch import MetricSettings, heatmap_metrics
-from vnrrt.predict.stage import run_predict_metrics, run_predict_part
 from vnrrt.search import path_mask
 
 N_RANDOM = 7  # with 5 named maps: 12 instances, not a multiple of the number of parts
@@ -127,7 +127,7 @@ def test_bad_parts_and_missing_heatmaps_are_named(predicted, tmp_path):
 def test_the_command_line_predicts_what_the_stage_predicted(predicted, tmp_path, capsys):
     """`vnrrt predict` and `vnrrt plan --checkpoint` on a named map give the pipeline's
     heatmap for that instance (row 2 of the parts: named map 3)."""
-    from vnrrt.cli import load_heatmap, main
+    from vnrrt.cli.main import load_heatmap, main
 
     cfg, _, _ = predicted
     ckpt = str(Path(cfg.paths.models) / "vertexnet.ckpt")
@@ -164,7 +164,7 @@ def test_the_command_line_predicts_what_the_stage_predicted(predicted, tmp_path,
 def _named_2(cfg):
     """The named-maps file, instance 2 of it (as the CLI reads it) and the heatmap part
     holding that instance."""
-    from vnrrt.cli import load_instance
+    from vnrrt.cli.main import load_instance
 
     files = [part_file(cfg.paths.heatmaps, k) for k in cfg.predict.parts]
     right = next(f for f in files if ((read_heatmaps(f)["keys"] == (-1, 2)).all(axis=1)).any())
@@ -174,7 +174,7 @@ def _named_2(cfg):
 def test_a_pipeline_heatmap_is_refused_for_endpoints_it_was_not_made_for(predicted, capsys):
     """A pipeline heatmap is its instance's, for that instance's own start and goal:
     --start/--goal that move them get a heatmap of other endpoints, which is refused."""
-    from vnrrt.cli import main
+    from vnrrt.cli.main import main
 
     named, inst, right = _named_2(predicted[0])
     heat = ["plan", "--map", named, "--instance", "2", "--heatmap", str(right), "--network",
@@ -192,7 +192,7 @@ def test_a_network_of_another_target_than_the_planner_samples_is_refused(predict
     """VNRRT* and M-VNRRT* sample vertex heatmaps, NRRT* path heatmaps: the command line
     refuses a checkpoint or a pipeline heatmap of the other network, naming both, and
     vnrrt.predict does given a target."""
-    from vnrrt.cli import main
+    from vnrrt.cli.main import main
     from vnrrt.model.checkpoint import CheckpointError
 
     cfg, _, _ = predicted

@@ -21,8 +21,8 @@ import pytest
 from mlflow import MlflowClient
 
 from tests.train_helpers import small_cfg
-from vnrrt import tracking
-from vnrrt.training.stage import run_train
+from vnrrt.pipeline.training import run_train
+from vnrrt.tracking import store as tracking
 
 
 def test_default_store_is_sqlite_in_the_repository(tmp_path, monkeypatch):
@@ -90,8 +90,8 @@ def test_params_are_flat_text_with_one_spelling_of_booleans_and_nulls():
 def test_a_training_run_is_recorded_in_mlflow(small_data, tmp_path, monkeypatch):
     import mlflow.pytorch
 
-    from vnrrt.lineage import file_md5
     from vnrrt.predict import heatmap
+    from vnrrt.tracking.lineage import file_md5
 
     monkeypatch.setenv("DVC_STAGE", "train@vertexnet")
     monkeypatch.setenv("DVC_EXP_NAME", "tidy-exp")
@@ -260,7 +260,8 @@ def test_a_stage_waits_out_seconds_of_sqlite_lock_contention(tmp_path):
     uri = f"sqlite:///{tmp_path / 'mlflow.db'}"
     want = tracking.experiment_id("vnrrt-lock", uri)
     child = subprocess.Popen(
-        [sys.executable, "-c", "import sys, mlflow; from vnrrt import tracking; print('ready', "
+        [sys.executable, "-c", "import sys, mlflow; from vnrrt.tracking import store as tracking; "
+         "print('ready', "
          "flush=True); sys.stdin.readline(); print(tracking.experiment_id('vnrrt-lock', "
          f"{uri!r}))"],
         stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
@@ -331,7 +332,7 @@ def test_open_experiment_closes_a_killed_evaluation_and_its_nested_runs(tmp_path
 
 def test_an_mlflow_model_that_cannot_be_loaded_is_one_line_exit_2(tmp_path, monkeypatch,
                                                                    capsys):  # fmt: skip
-    from vnrrt.cli import main
+    from vnrrt.cli.main import main
 
     monkeypatch.setenv("MLFLOW_TRACKING_URI", f"sqlite:///{tmp_path / 'mlflow.db'}")
     np.save(tmp_path / "map.npy", np.zeros((32, 32), np.uint8))

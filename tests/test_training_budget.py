@@ -22,12 +22,12 @@ from vnrrt.data.instances import Instances
 from vnrrt.data.targets import label_masks
 from vnrrt.evaluation.instances import build_instances
 from vnrrt.evaluation.table import SEEDED_COLUMNS, read_table
-from vnrrt.evaluation.training_budget.stage import run_budget_report, run_budget_trials
 from vnrrt.model.checkpoint import read_checkpoint
-from vnrrt.predict.stage import run_budget_predict, run_predict_metrics, run_predict_part
-from vnrrt.training.budget import batches_per_epoch
-from vnrrt.training.stage import run_budget_train
-from vnrrt.validate import validate_config
+from vnrrt.pipeline.predict import run_budget_predict, run_predict_metrics, run_predict_part
+from vnrrt.pipeline.training import run_budget_train
+from vnrrt.pipeline.training_budget import run_budget_report, run_budget_trials
+from vnrrt.pipeline.validate import validate_config
+from vnrrt.studies.training_budget.budget import batches_per_epoch
 
 N_RANDOM = 6
 # The settings a reader sees, none at its default: the report and figures must name these.

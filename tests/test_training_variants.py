@@ -9,7 +9,7 @@ import pytest
 
 from tests.train_helpers import SMALL, paths
 from vnrrt.config import compose
-from vnrrt.training.variants import SELECT, Variant, combined, main, pick, variants
+from vnrrt.pipeline.variants import SELECT, Variant, combined, main, pick, variants
 
 
 def test_the_variants_change_one_setting_each_and_skip_the_baseline():

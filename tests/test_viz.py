@@ -245,7 +245,7 @@ def test_regime_heatmap_cells_colour_bar_and_significance_marks():
 
 
 def _budget_summary() -> dict:
-    """A summary of two budgets (:mod:`vnrrt.evaluation.training_budget.summary`'s shape)."""
+    """A summary of two budgets (:mod:`vnrrt.studies.training_budget.summary`'s shape)."""
     keys, ratio_keys = (
         ["rrt_star", "nrrt_star", "vnrrt_star", "m_vnrrt_star@0.6"],
         ["vnrrt_star", "m_vnrrt_star@0.6"],

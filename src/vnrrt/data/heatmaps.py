@@ -31,8 +31,8 @@ from pathlib import Path
 
 import numpy as np
 
-from vnrrt.io import atomic_write_bytes
-from vnrrt.paths import heatmaps_part_file as part_file
+from vnrrt.config.paths import heatmaps_part_file as part_file
+from vnrrt.infra.io import atomic_write_bytes
 
 FORMAT_VERSION = 2
 PREFIX = "net_"  # field name prefix of a network's heatmaps

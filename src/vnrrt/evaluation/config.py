@@ -131,7 +131,7 @@ class StatsConfig:
 @dataclass
 class OracleConfig:
     """The ``oracle`` section: the oracle families of the sampling-ideas study
-    (:mod:`vnrrt.evaluation.sampling_ideas`)."""
+    (:mod:`vnrrt.studies.sampling_ideas`)."""
 
     families: dict[str, list[str]] = field(default_factory=lambda: {
         "path": ["oracle_path", "oracle_taut_path"],

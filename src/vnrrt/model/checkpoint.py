@@ -73,7 +73,7 @@ def checksum_file(path: str | Path) -> Path:
 
 def write_checksum(path: str | Path) -> str:
     """Record the checkpoint's sha256 beside it; returns the digest."""
-    from vnrrt.io import sha256, write_text
+    from vnrrt.infra.io import sha256, write_text
 
     digest = sha256(path)
     write_text(checksum_file(path), f"{digest}  {Path(path).name}\n")
@@ -83,7 +83,7 @@ def write_checksum(path: str | Path) -> str:
 def verify_checksum(path: str | Path, required: bool = False) -> None:
     """Raise :class:`CheckpointError` when the checkpoint's bytes do not match its recorded
     sha256 (a corrupted or swapped file), or when ``required`` and none is recorded."""
-    from vnrrt.io import sha256
+    from vnrrt.infra.io import sha256
 
     record = checksum_file(path)
     if not record.is_file():

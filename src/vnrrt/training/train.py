@@ -15,7 +15,7 @@ from pathlib import Path
 import lightning as L
 import torch
 
-from vnrrt.io import write_json
+from vnrrt.infra.io import write_json
 
 log = logging.getLogger(__name__)
 
