@@ -115,7 +115,11 @@ def closure(script: Path, params: dict | None = None) -> set[Path]:
     entry: tuple[str, str] | None = None  # (module, function) of the stage's entry point
     start: set[str] = set()
     for node in tree.body:
-        if isinstance(node, ast.ImportFrom) and node.module and node.module.startswith("vnrrt.pipeline."):
+        if (
+            isinstance(node, ast.ImportFrom)
+            and node.module
+            and node.module.startswith("vnrrt.pipeline.")
+        ):
             entry = (node.module, node.names[0].name)
         start |= {m for m in _names(node, "stages") if module_file(m) is not None}
     seen: set[str] = set()

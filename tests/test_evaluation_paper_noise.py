@@ -40,7 +40,7 @@ def test_the_delta_method_agrees_with_a_parametric_simulation(base, plan):
 
 
 def test_the_papers_claims_from_its_own_tables(repo):
-    paper = load_paper_tables(repo / "reports/paper/tables.yaml")
+    paper = load_paper_tables(repo / "data/paper/tables.yaml")
     got = {c["text"][:40]: claim_interval(paper, c, 0.95) for c in paper["claims"]}
     for claim, iv in zip(paper["claims"], got.values(), strict=True):
         assert iv.improvement == pytest.approx(claim["quoted"], abs=5e-4)  # the quoted value

@@ -94,11 +94,11 @@ def test_cells_show_censoring_and_fallbacks():
 
 
 def test_report_on_a_synthetic_table(repo):
-    paper = load_paper_tables(repo / "reports/paper/tables.yaml")
+    paper = load_paper_tables(repo / "data/paper/tables.yaml")
     st = StatsConfig(bootstrap=300, level=0.95)
     summary = analyze(synthetic_trials(), paper, 0.01, st, {"vertexnet": 15.0, "nrrtnet": 14.0})
     optima = {"map_1": {"astar": 110.0, "exact": 100.0, "taut": 101.0}}
-    settings = yaml.safe_load((repo / "reports/paper/settings.yaml").read_text())
+    settings = yaml.safe_load((repo / "data/paper/settings.yaml").read_text())
     values = {e["key"]: 0.5 for e in settings["settings"] if e.get("key")}
     trainings = {"vertexnet": {"steps": 10, "batch_size": 8, "train_images": 80,
                                "fit_seconds": 60.0, "network": {"encoder": "resnet18",

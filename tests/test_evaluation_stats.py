@@ -184,7 +184,7 @@ def test_verdict_rules(quoted, lo, hi, expected):
 
 
 def test_paper_tables_agree_with_the_improvements_quoted_in_the_text(repo):
-    paper = load_paper_tables(repo / "reports/paper/tables.yaml")
+    paper = load_paper_tables(repo / "data/paper/tables.yaml")
     for claim in paper["claims"]:
         col = paper["columns"].index(claim["column"])
         rows = paper["tables"][claim["table"]]["rows"]

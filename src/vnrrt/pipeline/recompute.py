@@ -8,7 +8,7 @@ comparison, the oracle study and the regime sweep (gzip CSV, columns of
 ``predict.json`` and training metrics, and the parameters.
 
 ``python -m vnrrt.pipeline.recompute run --bundle reports/cpu/results --out <folder>``
-recomputes from the bundle alone (with the repository's ``reports/paper/*.yaml``) the
+recomputes from the bundle alone (with the repository's ``data/paper/*.yaml``) the
 statistics (``summary.json``, ``ideas.json``), ``paper_comparison.md``,
 ``sampling_ideas.md`` and ``headline.json``, through the functions the stages use: the same
 numbers, byte for byte (tested at smoke scale). Figures are not redrawn.

@@ -1,4 +1,4 @@
-"""The paper's published numbers (``paths.paper_tables``, ``reports/paper/tables.yaml``: its
+"""The paper's published numbers (``paths.paper_tables``, ``data/paper/tables.yaml``: its
 Tables 1-3 and the improvements its text quotes), read once for both studies."""
 
 from __future__ import annotations

@@ -1,5 +1,5 @@
 """The report's disclosure sections: every planner and protocol setting beside the paper's
-(``reports/paper/settings.yaml``, our values from the run's config), the networks of this
+(``data/paper/settings.yaml``, our values from the run's config), the networks of this
 scale beside the paper's, and what each masked configuration's sampler actually samples."""
 
 from __future__ import annotations

@@ -2,7 +2,7 @@
 verdicts, and how to read both. A renderer only: every number comes from the summary of
 :func:`vnrrt.studies.paper_comparison.summary.analyze` (with the settings it was computed
 with: tolerance, CI level, resamples), the networks' metrics with the settings of
-``predict``, and the paper's numbers from ``reports/paper/tables.yaml`` (data, never typed in
+``predict``, and the paper's numbers from ``data/paper/tables.yaml`` (data, never typed in
 here).
 
 Cells are plain text on one line (no HTML), so the file reads the same on GitHub, in a

@@ -116,7 +116,7 @@ def extrapolation(summary: dict) -> list[str]:
     beyond = math.log2(paper / hi) if paper > 0 and hi > 0 else math.nan
     return [
         f"Extrapolation. The paper's networks saw at least {paper:,} images (its training set, "
-        f"for several epochs; `reports/paper/settings.yaml`), {beyond:.1f} doublings beyond the "
+        f"for several epochs; `data/paper/settings.yaml`), {beyond:.1f} doublings beyond the "
         f"largest budget here; the trends above are measured over {math.log2(hi / lo):.1f} "
         "doublings (none with one budget). They are not extended to the paper's budget, by a "
         "straight line or otherwise: no speed-up at that budget is a result of this report. "
