@@ -1,7 +1,7 @@
 """DVC stage budget_predict@<steps>: heatmaps and heatmap metrics of one budget's networks."""
 
 from vnrrt.cli.stage import stage_main
-from vnrrt.pipeline.predict import run_budget_predict
+from vnrrt.pipeline.training_budget import run_budget_predict
 
 if __name__ == "__main__":
     stage_main("budget_predict", run_budget_predict, __doc__, "steps", int, "budget.steps entry")

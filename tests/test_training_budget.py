@@ -23,9 +23,13 @@ from vnrrt.data.targets import label_masks
 from vnrrt.evaluation.instances import build_instances
 from vnrrt.evaluation.table import SEEDED_COLUMNS, read_table
 from vnrrt.model.checkpoint import read_checkpoint
-from vnrrt.pipeline.predict import run_budget_predict, run_predict_metrics, run_predict_part
-from vnrrt.pipeline.training import run_budget_train
-from vnrrt.pipeline.training_budget import run_budget_report, run_budget_trials
+from vnrrt.pipeline.predict import run_predict_metrics, run_predict_part
+from vnrrt.pipeline.training_budget import (
+    run_budget_predict,
+    run_budget_report,
+    run_budget_train,
+    run_budget_trials,
+)
 from vnrrt.pipeline.validate import validate_config
 from vnrrt.studies.training_budget.budget import batches_per_epoch
 

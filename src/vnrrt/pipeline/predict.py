@@ -5,9 +5,10 @@
   ``predict.threads``; the inference time goes to ``paths.timing_part(k)``);
 * ``predict_metrics``: the heatmap metrics over the named maps and the random instances with
   their settings, the inference time per map (``paths.predict_metrics``) and Fig. 3
-  (``paths.heatmaps_figure``); the MLflow run ``predict <scale>`` (:mod:`vnrrt.predict.runs`);
-* ``budget_predict@<steps>``: both, for the networks of one training budget (the budget
-  curve, :mod:`vnrrt.studies.training_budget.budget`), with a uniform map's metrics beside them.
+  (``paths.heatmaps_figure``); the MLflow run ``predict <scale>`` (:mod:`vnrrt.predict.runs`).
+
+The budget curve's ``budget_predict@<steps>`` (:mod:`.training_budget`) runs both for one
+training budget.
 """
 
 from __future__ import annotations
@@ -177,39 +178,4 @@ def run_predict_metrics(cfg: DictConfig) -> dict:
                  "instances": paths.instances}  # fmt: skip
         trainings = {n: paths.train_metrics(n) for n in results}
         log_predict(logger, str(cfg.scale.name), out, files, trainings, shown)
-    return out
-
-
-UNIFORM = 0.5  # the constant map whose metrics are "a uniform map's" (every pixel above tau 0.5)
-
-
-def run_budget_predict(cfg: DictConfig, steps: int) -> dict:
-    """Stage ``budget_predict@<steps>``: the heatmaps of every instance by the networks of
-    ``predict.networks`` trained for ``steps`` (``paths.budget_training``) ->
-    ``heatmaps/part_0.npz`` of ``paths.budget_heatmaps(steps)``, and their metrics as stage
-    ``predict_metrics`` computes them, beside those of a constant (uniform) map ``uniform``,
-    -> ``paths.budget_predict_metrics(steps)``; returns what it wrote."""
-    import dataclasses
-
-    from vnrrt.data.heatmaps import part_file, write_heatmaps
-    from vnrrt.data.instances import Instances
-    from vnrrt.infra.io import write_json
-
-    paths = section(cfg, "paths", Paths)
-    torch.set_num_threads(int(cfg.predict.threads))
-    instances = Instances(paths.instances)
-    rows = np.arange(len(instances))
-    nets = {n: paths.budget_training(n, steps).checkpoint for n in cfg.predict.networks}
-    maps, meta, timing = predict_rows(cfg, nets, instances, rows)
-    write_heatmaps(part_file(paths.budget_heatmaps(steps), 0), instances.keys, maps,
-                   networks=meta, part=0, parts=1, budget_steps=int(steps))  # fmt: skip
-    ms = metric_settings(cfg)
-    targets = {n: m["target"]["kind"] for n, m in meta.items()}
-    flat = np.full((len(instances), instances.size, instances.size), UNIFORM, np.float16)
-    out = {
-        "settings": dataclasses.asdict(ms),
-        "networks": network_metrics(maps, instances, ms, targets, [timing]),
-        "uniform": split_metrics(flat, instances, ms),
-    }
-    write_json(paths.budget_predict_metrics(steps), out)
     return out

@@ -1,5 +1,5 @@
-"""Entry points of the ``train@<network>`` stages and of the budget curve's
-``budget_train@<network>-<steps>`` (:mod:`vnrrt.studies.training_budget.budget`): build
+"""Entry points of the ``train@<network>`` stages, and the training of one network that the
+budget curve's ``budget_train@<network>-<steps>`` runs too (:mod:`.training_budget`): build
 every object from config with ``hydra.utils.instantiate`` (the network and loss from
 ``model``, the DataModule and the LightningModule factories from ``train``, the callbacks from
 ``callbacks``, the ``lightning.Trainer`` from ``trainer``; as lightning-hydra-template does),
@@ -185,17 +185,6 @@ def run_train(cfg: DictConfig, network: str) -> dict:
     return train_network(cfg, network, section(cfg, "paths", Paths).training(network))
 
 
-def run_budget_train(cfg: DictConfig, network: str, steps: int) -> dict:
-    """Stage ``budget_train@<network>-<steps>``: ``network`` trained for ``steps`` optimizer
-    steps with a schedule of its own (:func:`vnrrt.studies.training_budget.budget.budget_config`) ->
-    ``paths.budget_training(network, steps)``, resumable as the pipeline's trainings; its
-    metrics add ``budget`` (:func:`budget_record`)."""
-    from vnrrt.studies.training_budget.budget import budget_config
-
-    files = section(cfg, "paths", Paths).budget_training(network, steps)
-    return train_network(budget_config(cfg, steps), network, files, budget=int(steps))
-
-
 def train_network(cfg: DictConfig, network: str, files: TrainFiles,
                   budget: int | None = None) -> dict:  # fmt: skip
     """Train ``network`` as ``cfg`` says into ``files`` (module doc); ``budget``: the steps
@@ -245,6 +234,8 @@ def train_network(cfg: DictConfig, network: str, files: TrainFiles,
                                         files.metrics, batch, resume,
                                         with_val=budget is not None))  # fmt: skip
     if budget is not None:
+        from vnrrt.studies.training_budget.budget import budget_record
+
         metrics["budget"] = budget_record(trainer, budget)
     if trainer.is_global_zero:
         if logger is not None:
@@ -278,20 +269,3 @@ def finish_run(logger_cfg: tracking.LoggerConfig, scale: str, network: str, chec
         tested = {k: v for k, v in metrics.items() if k.startswith("test/")}
         out |= log_model(logger_cfg, scale, network, checkpoint, logger, example, tested)
     return out
-
-
-def budget_record(trainer, steps: int) -> dict:
-    """What a budget training adds to its metrics: its steps, epochs and batches per epoch,
-    and how far its learning-rate schedule ran (``schedule_steps`` of ``schedule_total``:
-    equal for a schedule of its own run to its end); ``ValueError`` unless it ran exactly
-    ``steps`` steps."""
-    from vnrrt.studies.training_budget.budget import check_steps
-
-    batches = int(trainer.limit_train_batches)
-    check_steps(int(trainer.global_step), steps, batches)
-    configs = trainer.lr_scheduler_configs
-    scheduler = configs[0].scheduler if configs else None
-    total = getattr(scheduler, "total_steps", None)
-    return {"steps": steps, "epochs": int(trainer.current_epoch), "batches_per_epoch": batches,
-            "schedule_steps": None if scheduler is None else int(scheduler.last_epoch),
-            "schedule_total": None if total is None else int(total)}  # fmt: skip

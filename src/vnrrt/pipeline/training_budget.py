@@ -1,5 +1,10 @@
-"""Entry points of the budget curve's evaluation stages (:mod:`.design` says what runs).
+"""Entry points of the budget curve's stages (:mod:`vnrrt.studies.training_budget`).
 
+* ``budget_train@<network>-<steps>``: one network trained for one budget
+  (:mod:`vnrrt.studies.training_budget.budget`) -> ``paths.budget_training(network, steps)``;
+* ``budget_predict@<steps>``: the heatmaps and heatmap metrics of one budget's networks, a
+  uniform map's metrics beside them -> ``paths.budget_heatmaps(steps)``,
+  ``paths.budget_predict_metrics(steps)``;
 * ``budget_trials@<steps>``: the trials of one training budget on its networks' heatmaps
   (``paths.budget_heatmaps(steps)``) -> ``paths.budget_trials(steps)``;
 * ``budget_report@training_budget``: every budget's trials, heatmap metrics and training
@@ -14,10 +19,61 @@ from pathlib import Path
 
 from omegaconf import DictConfig
 
-from vnrrt.config import ConfigError, sections
+from vnrrt.config import ConfigError, section, sections
 from vnrrt.config.paths import Paths
 
 log = logging.getLogger(__name__)
+
+
+def run_budget_train(cfg: DictConfig, network: str, steps: int) -> dict:
+    """Stage ``budget_train@<network>-<steps>``: ``network`` trained for ``steps`` optimizer
+    steps with a schedule of its own (:func:`vnrrt.studies.training_budget.budget.budget_config`) ->
+    ``paths.budget_training(network, steps)``, resumable as the pipeline's trainings; its
+    metrics add ``budget`` (:func:`~vnrrt.studies.training_budget.budget.budget_record`)."""
+    from vnrrt.pipeline.training import train_network
+    from vnrrt.studies.training_budget.budget import budget_config
+
+    files = section(cfg, "paths", Paths).budget_training(network, steps)
+    return train_network(budget_config(cfg, steps), network, files, budget=int(steps))
+
+
+UNIFORM = 0.5  # the constant map whose metrics are "a uniform map's" (every pixel above tau 0.5)
+
+
+def run_budget_predict(cfg: DictConfig, steps: int) -> dict:
+    """Stage ``budget_predict@<steps>``: the heatmaps of every instance by the networks of
+    ``predict.networks`` trained for ``steps`` (``paths.budget_training``) ->
+    ``heatmaps/part_0.npz`` of ``paths.budget_heatmaps(steps)``, and their metrics as stage
+    ``predict_metrics`` computes them, beside those of a constant (uniform) map ``uniform``,
+    -> ``paths.budget_predict_metrics(steps)``; returns what it wrote."""
+    import dataclasses
+
+    import numpy as np
+    import torch
+
+    from vnrrt.data.heatmaps import part_file, write_heatmaps
+    from vnrrt.data.instances import Instances
+    from vnrrt.infra.io import write_json
+    from vnrrt.pipeline.predict import metric_settings, network_metrics, predict_rows, split_metrics
+
+    paths = section(cfg, "paths", Paths)
+    torch.set_num_threads(int(cfg.predict.threads))
+    instances = Instances(paths.instances)
+    rows = np.arange(len(instances))
+    nets = {n: paths.budget_training(n, steps).checkpoint for n in cfg.predict.networks}
+    maps, meta, timing = predict_rows(cfg, nets, instances, rows)
+    write_heatmaps(part_file(paths.budget_heatmaps(steps), 0), instances.keys, maps,
+                   networks=meta, part=0, parts=1, budget_steps=int(steps))  # fmt: skip
+    ms = metric_settings(cfg)
+    targets = {n: m["target"]["kind"] for n, m in meta.items()}
+    flat = np.full((len(instances), instances.size, instances.size), UNIFORM, np.float16)
+    out = {
+        "settings": dataclasses.asdict(ms),
+        "networks": network_metrics(maps, instances, ms, targets, [timing]),
+        "uniform": split_metrics(flat, instances, ms),
+    }
+    write_json(paths.budget_predict_metrics(steps), out)
+    return out
 
 
 def _design(cfg: DictConfig) -> dict:

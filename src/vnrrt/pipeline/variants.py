@@ -13,7 +13,8 @@ the path ends the target keeps (``networks.vertexnet.endpoints``), the target di
 positive weight (``model.loss.alpha``) and the output prior (``model.net.prior``); a variant
 equal to the baseline is run once. Then the combination of every factor's best level, where
 two or more factors beat the baseline. Each variant is a budget training
-(:func:`vnrrt.pipeline.training.run_budget_train`: a one-cycle schedule of its own ``--steps``)
+(:func:`vnrrt.pipeline.training_budget.run_budget_train`: a one-cycle schedule of its own
+``--steps``)
 in ``--work/<variant>/`` (default ``models/<scale>/variants``), MLflow off; a finished one
 is read back, an interrupted one resumes. Needs the scale's shards (``dvc repro manifest``
 at that scale). Writes the note ``--out`` (markdown) and its figures as JSON beside it.
@@ -104,7 +105,7 @@ def train_variant(base: list[str], variant: Variant, steps: int, work: Path) -> 
     from vnrrt.config import compose, section
     from vnrrt.config.paths import Paths
     from vnrrt.infra.io import read_json
-    from vnrrt.pipeline.training import run_budget_train
+    from vnrrt.pipeline.training_budget import run_budget_train
 
     folder = work / variant.slug
     places = [

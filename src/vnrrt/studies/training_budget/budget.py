@@ -63,3 +63,18 @@ def check_steps(done: int, steps: int, batches: int) -> None:
             f"the budget of {steps} steps ended at step {done}: trainer.max_time was reached, "
             f"or the train split holds fewer than {batches} batches per epoch"
         )
+
+
+def budget_record(trainer, steps: int) -> dict:
+    """What a budget training adds to its metrics: its steps, epochs and batches per epoch,
+    and how far its learning-rate schedule ran (``schedule_steps`` of ``schedule_total``:
+    equal for a schedule of its own run to its end); ``ValueError`` unless it ran exactly
+    ``steps`` steps."""
+    batches = int(trainer.limit_train_batches)
+    check_steps(int(trainer.global_step), steps, batches)
+    configs = trainer.lr_scheduler_configs
+    scheduler = configs[0].scheduler if configs else None
+    total = getattr(scheduler, "total_steps", None)
+    return {"steps": steps, "epochs": int(trainer.current_epoch), "batches_per_epoch": batches,
+            "schedule_steps": None if scheduler is None else int(scheduler.last_epoch),
+            "schedule_total": None if total is None else int(total)}  # fmt: skip
