@@ -48,7 +48,7 @@ DEFAULT_TEXTS = ("within 1%", "1% of", "95%", "eps 0.01", "eps = 0.01", "τ=0.9"
 # end, at one budget of the pipeline training's own 3 steps (so they must reproduce it).
 BUDGET_STAGES = {"budget_train", "budget_predict", "budget_trials", "budget_report"}
 ONE_BUDGET = ["budget.steps=[3]", "budget.report=[training_budget]"]
-AUDIT = Path(__file__).resolve().parent / "write_audit"
+AUDIT = Path(__file__).resolve().parents[1] / "write_audit"
 
 
 def write_log(work: Path) -> Path:

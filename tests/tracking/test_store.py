@@ -112,7 +112,7 @@ def test_a_training_run_is_recorded_in_mlflow(small_data, tmp_path, monkeypatch)
     assert tags["dvc_stage"] == "train@vertexnet" and tags["dvc_experiment"] == "tidy-exp"
     assert tags["kind"] == "vertexnet" and tags["scale"] == "smoke"
     assert tags["checkpoint_sha256"] == metrics["checkpoint_sha256"]
-    assert tags["git_commit"] == tracking.git_commit(Path(__file__).resolve().parents[1])
+    assert tags["git_commit"] == tracking.git_commit(Path(__file__).resolve().parents[2])
     params = run.data.params
     assert params["model.net.encoder"] == "resnet18" and params["network.target"] == "vertex"
     assert params["train.datamodule.batch_size"] == str(cfg.train.datamodule.batch_size)

@@ -16,7 +16,7 @@ from vnrrt.config import compose, dump
 from vnrrt.data.heatmaps import read_parts
 from vnrrt.model.checkpoint import load_network
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 
 
 def run(cmd: list[str], cwd: Path) -> str:

@@ -31,7 +31,7 @@ def run(cmd: list[str], cwd: Path, env: dict, timeout: float = 300) -> str:
 @pytest.fixture(scope="module")
 def expected(tmp_path_factory) -> dict[int, bytes]:
     """Smoke shards built by ``build_shard`` directly, with the arguments stage shard@<id>
-    passes (tests/test_pipeline.py checks the stage against the same call)."""
+    passes (tests/pipeline/test_pipeline.py checks the stage against the same call)."""
     cfg = compose(SMOKE)
     out = tmp_path_factory.mktemp("direct")
     data, labels = section(cfg, "data", DataConfig), section(cfg, "labels", LabelsConfig)

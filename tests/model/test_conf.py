@@ -9,7 +9,7 @@ from hydra.utils import instantiate
 
 from vnrrt.model import FocalLoss, VertexNet
 
-CONF = Path(__file__).resolve().parents[1] / "conf"
+CONF = Path(__file__).resolve().parents[2] / "conf"
 MODELS = sorted(p.stem for p in (CONF / "model").glob("*.yaml"))
 
 

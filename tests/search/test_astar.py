@@ -166,7 +166,7 @@ def detour_grid(rng: np.random.Generator, h: int, w: int) -> np.ndarray:
 @given(st.integers(0, 10**6))
 def test_astar_is_optimal_where_the_heuristic_matters(seed):
     """Mutations of vnrrt.search.astar this test must catch (each checked once by hand and
-    by tests/test_search_astar_mutations.py, slow):
+    by tests/search/test_astar_mutations.py, slow):
 
     * an overestimating heuristic, ``max + min`` instead of ``max + (sqrt 2 - 1) min``;
     * diagonal moves costing 1 instead of sqrt 2;

@@ -1,6 +1,6 @@
 """The budget curve (issue 24): a budget of N steps is a whole training of N steps (its own
 one-cycle schedule, run to its end; that the budget of a training's own steps is that
-training: the slow DVC test in tests/test_pipeline.py), its heatmap metrics are those of
+training: the slow DVC test in tests/pipeline/test_pipeline.py), its heatmap metrics are those of
 stage ``predict_metrics`` on the same checkpoint (and a uniform map's are what a uniform map
 gives), and a smoke-sized curve (64x64 maps, budgets of 2 and 4 steps) renders its table,
 trends and figures from paired trials."""
@@ -157,7 +157,8 @@ def curve(small_data, tmp_path_factory):
 def test_a_budget_of_n_steps_is_a_whole_training_of_n_steps(curve):
     """Each budget ends at its step with a schedule sized to it and run to its end (the rate
     of its last step is the schedule's final value, not that of a longer schedule cut short).
-    That the budget of a training's own steps is that training: tests/test_pipeline.py (slow)."""
+    That the budget of a training's own steps is that training:
+    tests/pipeline/test_pipeline.py (slow)."""
     cfg, summary = curve
     models = Path(cfg.paths.models)
     for b in summary["budgets"]:

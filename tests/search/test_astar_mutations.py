@@ -1,5 +1,5 @@
 """Mutation check of the A* tests (slow): each deliberate bug below, applied to a copy of the
-package, must make ``tests/test_search_astar.py`` fail. A test suite that stays green on a
+package, must make ``tests/search/test_astar.py`` fail. A test suite that stays green on a
 wrong A* would let a longer-than-optimal reference into every "optimal" stop rule."""
 
 import os
@@ -38,6 +38,6 @@ def test_each_mutation_of_astar_is_caught(name, repo, tmp_path):
     env = dict(os.environ, PYTHONPATH=str(copy / "src"), NUMBA_CACHE_DIR=str(tmp_path / "nb"),
                CI="1")  # fmt: skip
     proc = subprocess.run([sys.executable, "-m", "pytest", "-q", "-x", "-p", "no:cacheprovider",
-                           "tests/test_search_astar.py"], cwd=copy, env=env,
+                           "tests/search/test_astar.py"], cwd=copy, env=env,
                           capture_output=True, text=True, timeout=900)  # fmt: skip
     assert proc.returncode != 0, f"mutation {name!r} survived:\n{proc.stdout[-2000:]}"

@@ -6,6 +6,7 @@ import zipfile
 import numpy as np
 import pytest
 
+from tests.search.test_astar import assert_valid_path
 from vnrrt.data.build import build_shard, split_of_maps
 from vnrrt.data.build_named import build_named_maps
 from vnrrt.data.config import LabelsConfig
@@ -14,8 +15,6 @@ from vnrrt.data.reader import Shard
 from vnrrt.data.shards import FIELDS, ShardError, read_arrays, shard_file, write_shard
 from vnrrt.maps.config import DataConfig
 from vnrrt.search import astar, path_length, path_vertices
-
-from .test_search_astar import assert_valid_path
 
 MAPS = 3
 
