@@ -18,7 +18,7 @@ field               shape, dtype        meaning
 ``net_<network>``   (N, S, S) float16   that network's heatmaps, in ``keys`` order
 ==================  ==================  ==================================================
 
-The evaluation instances are :func:`vnrrt.data.datamodule.evaluation_keys`: ``R`` evenly
+The evaluation instances are :func:`vnrrt.data.splits.evaluation_keys`: ``R`` evenly
 spaced instances of the test split (test maps of the shards, in shard order).
 """
 

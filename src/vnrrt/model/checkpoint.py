@@ -1,8 +1,9 @@
 """Checkpoints of trained networks: checking them before resuming, loading them to predict.
 
-A checkpoint is Lightning's file plus a ``"vnrrt"`` record (:func:`vnrrt.train.make_record`):
-the network's config, its target, the input rendering and a sha256 of the record and the
-weights (:func:`vnrrt.model.record.record_digest`, written when the file is saved). A
+A checkpoint is Lightning's file plus a ``"vnrrt"`` record
+(:func:`vnrrt.pipeline.training.make_record`): the network's config, its target, the input
+rendering and a sha256 of the record and the weights (:func:`vnrrt.model.record.record_digest`,
+written when the file is saved). A
 checkpoint is only ever used from an explicit path (config or DVC stage), never found by
 globbing.
 

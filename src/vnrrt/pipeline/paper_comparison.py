@@ -1,12 +1,14 @@
 """Entry points of the paper comparison's stages.
 
 * ``evaluate``: the trial parts merged once (checked complete) into ``paths.trials_table``,
-  every statistic of the report (``paths.summary``, :func:`.summary.analyze`) and the
-  convergence curves (``paths.convergence``, ``paths.convergence_plots``);
-* ``report``: ``paths.report`` (:func:`.report.build_report`), Fig. 5 and the convergence
-  figure (``paths.evaluation_figures``), the headline metrics (``paths.headline``) and the
-  MLflow evaluation runs (:mod:`.runs`; they link the ideas run of ``paths.ideas_summary``
-  and log the heatmap parts of ``paths.heatmaps`` as datasets).
+  every statistic of the report (``paths.summary``,
+  :func:`~vnrrt.studies.paper_comparison.summary.analyze`) and the convergence curves
+  (``paths.convergence``, ``paths.convergence_plots``);
+* ``report``: ``paths.report`` (:func:`~vnrrt.studies.paper_comparison.report.build_report`),
+  Fig. 5 and the convergence figure (``paths.evaluation_figures``), the headline metrics
+  (``paths.headline``) and the
+  MLflow evaluation runs (:mod:`vnrrt.studies.paper_comparison.runs`; they link the ideas run
+  of ``paths.ideas_summary`` and log the heatmap parts of ``paths.heatmaps`` as datasets).
 """
 
 from __future__ import annotations
@@ -55,7 +57,8 @@ def run_evaluate(cfg: DictConfig) -> dict:
 
 
 def evaluate_summary(table, s: dict, predict: dict) -> dict:
-    """The summary of the merged trial ``table`` (:func:`.summary.analyze`) with stage
+    """The summary of the merged trial ``table``
+    (:func:`~vnrrt.studies.paper_comparison.summary.analyze`) with stage
     ``evaluate``'s settings ``s`` and the networks' inference times of ``predict``
     (``predict.json``)."""
     from vnrrt.studies.paper_comparison.summary import analyze

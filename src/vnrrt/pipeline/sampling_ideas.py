@@ -31,7 +31,7 @@ class StudyRules(Rules):
     overrides (``planner.eta``, ``radius_mode``, ``gamma_factor``, ``fixed_radius``,
     ``goal_radius``: their meaning in :class:`~vnrrt.planners.config.PlannerConfig`), for
     stage ``ideas``, which plans nothing: they say which grid cell is the protocol's own
-    (:func:`.design.protocol_settings`)."""
+    (:func:`~vnrrt.studies.sampling_ideas.design.protocol_settings`)."""
 
     eta: float = 10.0
     radius_mode: str = "shrinking"
@@ -43,7 +43,8 @@ class StudyRules(Rules):
 @dataclass(frozen=True)
 class Study:
     """The typed sections the study's stages read (``regime`` is None in the selection);
-    ``protocol``: the protocol cell's planner settings (:func:`.design.protocol_settings`)."""
+    ``protocol``: the protocol cell's planner settings
+    (:func:`~vnrrt.studies.sampling_ideas.design.protocol_settings`)."""
 
     paths: Paths
     ev: Configurations
@@ -74,7 +75,8 @@ class Study:
                           instances=sel)  # fmt: skip
 
     def envelopes(self) -> tuple[dict, dict]:
-        """``(speed-ups, envelopes)`` of the merged selection (:mod:`.selection`)."""
+        """``(speed-ups, envelopes)`` of the merged selection
+        (:mod:`~vnrrt.studies.sampling_ideas.selection`)."""
         from vnrrt.evaluation.table import merge_parts
         from vnrrt.studies.sampling_ideas.design import family_members
         from vnrrt.studies.sampling_ideas.selection import member_speedups, select
@@ -117,7 +119,8 @@ def part_settings(cfg: DictConfig, which: str) -> dict:
 
 def ideas_settings(cfg: DictConfig) -> dict:
     """What stage ``ideas`` reads, typed (keyed by config section; ``protocol``: the
-    protocol cell's planner settings, :func:`.design.protocol_settings`)."""
+    protocol cell's planner settings,
+    :func:`~vnrrt.studies.sampling_ideas.design.protocol_settings`)."""
     from vnrrt.evaluation.config import StatsConfig
     from vnrrt.studies.sampling_ideas.design import protocol_settings
     from vnrrt.tracking.store import LoggerConfig
@@ -198,7 +201,8 @@ def ideas_tables(settings: dict) -> dict:
 
 
 def ideas_summary(tables: dict, settings: dict) -> dict:
-    """The study's statistics (:func:`.summary.analyze_study`) of the merged ``tables``
+    """The study's statistics (:func:`~vnrrt.studies.sampling_ideas.summary.analyze_study`) of the
+    merged ``tables``
     with stage ``ideas``'s settings, which the summary records (``settings``)."""
     from vnrrt.infra.io import read_json
     from vnrrt.studies.paper_tables import claim_pairs, load_paper_tables

@@ -77,7 +77,7 @@ def run_budget_predict(cfg: DictConfig, steps: int) -> dict:
 
 
 def _design(cfg: DictConfig) -> dict:
-    """The ``eval`` keys of :class:`.design.BudgetTrials`, typed."""
+    """The ``eval`` keys of :class:`~vnrrt.studies.training_budget.design.BudgetTrials`, typed."""
     ev = cfg.eval
     return {
         "planners": [str(p) for p in ev.planners],
