@@ -34,7 +34,7 @@ format: $(STAMP)  ## apply ruff fixes and formatting
 	$(BIN)/ruff format .
 
 params: $(STAMP)  ## write params.yaml from conf/ (the default composition, as DVC does; validated)
-	$(BIN)/python -m vnrrt.params --out params.yaml
+	$(BIN)/python -m vnrrt.pipeline.params --out params.yaml
 
 repro: $(STAMP)  ## run the whole pipeline (dvc repro) at the default scale; saved as experiment local-default
 	$(BIN)/dvc repro
@@ -59,7 +59,7 @@ repro-cpu: $(STAMP)  ## the CPU study scale (about 3 h on 2 cores): the pipeline
 	$(BIN)/dvc exp run -S scale=cpu ideas report
 	rm -rf $(CPU_REPORTS) && mkdir -p $(CPU_REPORTS)/seed1
 	cp -r reports/paper_comparison.md reports/sampling_ideas.md reports/metrics reports/figures $(CPU_REPORTS)/
-	$(BIN)/python -m vnrrt.evaluation.recompute export --params params.yaml --out $(CPU_REPORTS)/results
+	$(BIN)/python -m vnrrt.pipeline.recompute export --params params.yaml --out $(CPU_REPORTS)/results
 	$(BIN)/dvc exp run -S scale=cpu -S train.seed=1 predict_metrics
 	cp reports/metrics/train_*.json reports/metrics/predict.json $(CPU_REPORTS)/seed1/
 	$(BIN)/dvc exp run -S scale=cpu

@@ -109,7 +109,7 @@ def main(argv: list[str] | None = None) -> int:
             "exact any-angle optimum; times in ms (med_ok: solved runs; med_all: every run, "
             "unsolved at its budget; call: the whole plan() call)",
             f"# 1-min load average {load[0]:.2f} before, {after[0]:.2f} after"]  # fmt: skip
-    from vnrrt.io import write_text
+    from vnrrt.infra.io import write_text
 
     write_text(args.out, "\n".join([*head, *lines]) + "\n")
     print(f"written: {args.out}")

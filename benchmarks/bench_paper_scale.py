@@ -41,10 +41,10 @@ from vnrrt.data.shards import shard_file
 from vnrrt.evaluation.config import EvalConfig
 from vnrrt.evaluation.protocol import configurations, trial_counts
 from vnrrt.evaluation.table import read_table
+from vnrrt.infra.parallel import n_workers
 from vnrrt.maps.config import DataConfig
 from vnrrt.model import FocalLoss, VertexNet
 from vnrrt.names import mask_taus
-from vnrrt.parallel import n_workers
 from vnrrt.planners import PlannerConfig, plan, warmup
 from vnrrt.planners.reference import any_angle_length
 

@@ -187,7 +187,7 @@ def run_data(args: argparse.Namespace) -> None:
 def run_learning(args: argparse.Namespace) -> None:
     """``learning`` (module doc)."""
     from vnrrt.config import compose
-    from vnrrt.training.stage import run_train
+    from vnrrt.pipeline.training import run_train
 
     print(f"learning per CPU-minute: {args.minutes:g} min of steps each, quick shards, "
           f"batch {BATCH}\n  variant (model:target_radius)  steps  fit s  interior AP  "

@@ -1,7 +1,7 @@
 """DVC stage budget_predict@<steps>: heatmaps and heatmap metrics of one budget's networks."""
 
-from vnrrt.predict.stage import run_budget_predict
-from vnrrt.stage_cli import stage_main
+from vnrrt.cli.stage import stage_main
+from vnrrt.pipeline.training_budget import run_budget_predict
 
 if __name__ == "__main__":
     stage_main("budget_predict", run_budget_predict, __doc__, "steps", int, "budget.steps entry")

@@ -1,7 +1,7 @@
 """DVC stage budget_report@training_budget: the budget curve's statistics, report, figures."""
 
-from vnrrt.evaluation.training_budget.stage import run_budget_report
-from vnrrt.stage_cli import stage_main
+from vnrrt.cli.stage import stage_main
+from vnrrt.pipeline.training_budget import run_budget_report
 
 if __name__ == "__main__":
     stage_main("budget_report", run_budget_report, __doc__, "name", str, "budget.report entry")

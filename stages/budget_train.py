@@ -1,7 +1,7 @@
 """DVC stage budget_train@<network>-<steps>: one network of the training-budget curve."""
 
-from vnrrt.stage_cli import stage_main
-from vnrrt.training.stage import run_budget_train
+from vnrrt.cli.stage import stage_main
+from vnrrt.pipeline.training_budget import run_budget_train
 
 if __name__ == "__main__":
     stage_main("budget_train", run_budget_train, __doc__, "network", str, "vertexnet or nrrtnet",

@@ -1,7 +1,7 @@
 """DVC stage evaluate: the trial parts merged, statistics and convergence curves."""
 
-from vnrrt.evaluation.paper_comparison.stage import run_evaluate
-from vnrrt.stage_cli import stage_main
+from vnrrt.cli.stage import stage_main
+from vnrrt.pipeline.paper_comparison import run_evaluate
 
 if __name__ == "__main__":
     stage_main("evaluate", run_evaluate, __doc__)

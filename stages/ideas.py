@@ -1,7 +1,7 @@
 """DVC stage ideas: the oracle study and regime sweep merged, sampling_ideas.md, figures."""
 
-from vnrrt.evaluation.sampling_ideas.stage import run_ideas
-from vnrrt.stage_cli import stage_main
+from vnrrt.cli.stage import stage_main
+from vnrrt.pipeline.sampling_ideas import run_ideas
 
 if __name__ == "__main__":
     stage_main("ideas", run_ideas, __doc__)

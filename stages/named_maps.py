@@ -1,7 +1,7 @@
 """DVC stage named_maps: the five named maps (Fig. 4) as a shard and a figure."""
 
-from vnrrt.data.stage import run_named_maps
-from vnrrt.stage_cli import stage_main
+from vnrrt.cli.stage import stage_main
+from vnrrt.pipeline.data import run_named_maps
 
 if __name__ == "__main__":
     stage_main("named_maps", run_named_maps, __doc__)

@@ -1,7 +1,7 @@
 """DVC stage predict@<k>: heatmaps of the networks for part k of the instances."""
 
-from vnrrt.predict.stage import run_predict_part
-from vnrrt.stage_cli import stage_main
+from vnrrt.cli.stage import stage_main
+from vnrrt.pipeline.predict import run_predict_part
 
 if __name__ == "__main__":
     stage_main("predict", run_predict_part, __doc__, "part", int, "part id (predict.parts)")

@@ -1,7 +1,7 @@
 """DVC stage predict_metrics: heatmap metrics, inference time and Fig. 3."""
 
-from vnrrt.predict.stage import run_predict_metrics
-from vnrrt.stage_cli import stage_main
+from vnrrt.cli.stage import stage_main
+from vnrrt.pipeline.predict import run_predict_metrics
 
 if __name__ == "__main__":
     stage_main("predict_metrics", run_predict_metrics, __doc__)

@@ -1,7 +1,7 @@
 """DVC stage regime@<k>: part k of the planner-regime sweep."""
 
-from vnrrt.evaluation.sampling_ideas.stage import run_regime_part
-from vnrrt.stage_cli import stage_main
+from vnrrt.cli.stage import stage_main
+from vnrrt.pipeline.sampling_ideas import run_regime_part
 
 if __name__ == "__main__":
     stage_main("regime", run_regime_part, __doc__, "part", int, "part id (regime.parts)")

@@ -1,7 +1,7 @@
 """DVC stage report: paper_comparison.md, figures, headline metrics, MLflow runs."""
 
-from vnrrt.evaluation.paper_comparison.stage import run_report
-from vnrrt.stage_cli import stage_main
+from vnrrt.cli.stage import stage_main
+from vnrrt.pipeline.paper_comparison import run_report
 
 if __name__ == "__main__":
     stage_main("report", run_report, __doc__)

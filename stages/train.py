@@ -1,7 +1,7 @@
 """DVC stage train@<network>: train VertexNet or the NRRT* network."""
 
-from vnrrt.stage_cli import stage_main
-from vnrrt.training.stage import run_train
+from vnrrt.cli.stage import stage_main
+from vnrrt.pipeline.training import run_train
 
 if __name__ == "__main__":
     stage_main("train", run_train, __doc__, "network", str, "vertexnet or nrrtnet")

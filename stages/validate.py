@@ -1,7 +1,7 @@
 """DVC stage validate: check the whole composed configuration before any work."""
 
-from vnrrt.stage_cli import stage_main
-from vnrrt.validate import run_validate
+from vnrrt.cli.stage import stage_main
+from vnrrt.pipeline.validate import run_validate
 
 if __name__ == "__main__":
     stage_main("validate", run_validate, __doc__)

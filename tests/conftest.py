@@ -53,7 +53,7 @@ def trained(small_data, tmp_path_factory) -> Path:
     """Outputs (``models/vertexnet.ckpt``, ``models/nrrtnet.ckpt``, metrics) of two training
     steps of each network on the 64x64 smoke data."""
     from tests.train_helpers import QUICK, small_cfg
-    from vnrrt.training.stage import run_train as train
+    from vnrrt.pipeline.training import run_train as train
 
     out = tmp_path_factory.mktemp("trained")
     cfg = small_cfg(small_data, out, *QUICK)
@@ -62,7 +62,7 @@ def trained(small_data, tmp_path_factory) -> Path:
     return out
 
 
-PIPELINE_FILES = ["dvc.yaml", "conf", "stages", "src", ".dvcignore", "reports/paper", "reports/gpu"]
+PIPELINE_FILES = ["dvc.yaml", "conf", "stages", "src", ".dvcignore", "data/paper", "reports/gpu"]
 DVC_FILES = [".dvc/config", ".dvc/plots/series.json"]  # copied after `dvc init`
 
 

@@ -1,7 +1,7 @@
 """What a reviewer finds in MLflow after the smoke pipeline, read through a tracking server's
 REST API (:mod:`tests.mlflow_server`) and checked against the pipeline's own files: the
 statistics files, the training metrics and DVC's lock file (the independent record of every
-file's hash). Used by ``tests/test_pipeline.py``."""
+file's hash). Used by ``tests/pipeline/test_pipeline.py``."""
 
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ from pathlib import Path
 import yaml
 
 from tests.mlflow_server import Rest, metrics, params, tags
-from vnrrt.evaluation.paper_comparison.claims import verdict_text
+from vnrrt.studies.paper_comparison.claims import verdict_text
 
 IMAGE = re.compile(r"!\[[^\]]*\]\(([^)\s]+)\)")
 LINK = re.compile(r"\]\((#/[^)\s]+)\)")

@@ -1,7 +1,7 @@
 """The code a DVC stage runs: the import closure of its script inside ``src/vnrrt``.
 
 Rule: start from ``stages/<stage>.py``. The module that defines the stage's entry function
-(``stage.py`` of a subpackage) counts with its module-level imports and the imports inside
+(a module of ``vnrrt.pipeline``) counts with its module-level imports and the imports inside
 that function and the module's functions it calls (its other entry functions belong to other
 stages); every other module
 counts with all its imports (module level and inside functions: they run when called). Each
@@ -115,7 +115,11 @@ def closure(script: Path, params: dict | None = None) -> set[Path]:
     entry: tuple[str, str] | None = None  # (module, function) of the stage's entry point
     start: set[str] = set()
     for node in tree.body:
-        if isinstance(node, ast.ImportFrom) and node.module and node.module.endswith(".stage"):
+        if (
+            isinstance(node, ast.ImportFrom)
+            and node.module
+            and node.module.startswith("vnrrt.pipeline.")
+        ):
             entry = (node.module, node.names[0].name)
         start |= {m for m in _names(node, "stages") if module_file(m) is not None}
     seen: set[str] = set()

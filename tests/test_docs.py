@@ -137,7 +137,7 @@ def _check_python(argv: list[str]) -> None:
 
 
 def _check_dvc(argv: list[str], capsys) -> None:
-    from vnrrt.params import main as compose
+    from vnrrt.pipeline.params import main as compose
 
     words = [a for a in argv[2:] if not a.startswith("-")]
     if argv[1:3] == ["exp", "run"]:
@@ -168,7 +168,7 @@ def test_every_command_names_what_exists(page, argv, capsys):
     elif program == "python":
         _check_python(argv)
     elif program == "vnrrt":
-        from vnrrt.cli import build_parser
+        from vnrrt.cli.main import build_parser
 
         assert callable(build_parser().parse_args(argv[1:]).func)
     elif program == "dvc":

@@ -47,7 +47,7 @@ def installed(repo, tmp_path_factory) -> tuple[Path, str, Path]:
 
 def test_the_wheel_installs_and_answers_outside_the_repository(installed, repo):
     py, purelib, work = installed
-    code = "import vnrrt, vnrrt.planners, vnrrt.cli; print(vnrrt.__file__)"
+    code = "import vnrrt, vnrrt.planners, vnrrt.cli.main; print(vnrrt.__file__)"
     where = subprocess.run([py, "-c", code], cwd=work, capture_output=True, text=True,
                            check=True).stdout  # fmt: skip
     assert str(repo) not in where and purelib in where

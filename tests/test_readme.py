@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from vnrrt.cli import build_parser, main
+from vnrrt.cli.main import build_parser, main
 from vnrrt.search import any_angle_path
 
 ROOT = Path(__file__).resolve().parents[1]

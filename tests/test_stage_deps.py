@@ -28,16 +28,16 @@ def test_code_deps_equal_the_import_closure(name):
 def test_the_closure_sees_function_level_imports_and_hydra_targets():
     train = {str(p) for p in closure(STAGES["train"], declared_params("train"))}
     assert "src/vnrrt/data/datamodule.py" in train  # train.datamodule._target_
-    assert "src/vnrrt/training/callbacks.py" in train  # callbacks.*._target_
+    assert "src/vnrrt/pipeline/callbacks.py" in train  # callbacks.*._target_
     assert "src/vnrrt/viz/training.py" in train  # imported inside a callback method
     assert "src/vnrrt/viz/evaluation.py" not in train
     trials = {str(p) for p in closure(STAGES["trials"], declared_params("trials"))}
     assert (
-        "src/vnrrt/evaluation/paper_comparison/report.py" not in trials
+        "src/vnrrt/studies/paper_comparison/report.py" not in trials
     )  # a wording change re-runs no trial
     assert "src/vnrrt/evaluation/stats.py" not in trials
     oracle = {str(p) for p in closure(STAGES["oracle"], declared_params("oracle"))}
     assert "src/vnrrt/evaluation/sources.py" in oracle  # imported by a helper the entry calls
     assert "src/vnrrt/planners/core.py" in oracle
     shard = {str(p) for p in closure(STAGES["shard"], declared_params("shard"))}
-    assert "src/vnrrt/maps/named.py" not in shard and "src/vnrrt/parallel.py" in shard
+    assert "src/vnrrt/maps/named.py" not in shard and "src/vnrrt/infra/parallel.py" in shard

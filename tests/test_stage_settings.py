@@ -14,11 +14,11 @@ import yaml
 
 from tests.stage_closure import REPO
 from vnrrt.config import compose, restrict, stage_params
-from vnrrt.evaluation.paper_comparison.stage import evaluate_settings, report_settings
-from vnrrt.evaluation.sampling_ideas.stage import ideas_settings, part_settings
-from vnrrt.evaluation.stage import instances_settings, trials_settings
-from vnrrt.evaluation.training_budget import stage as budget
-from vnrrt.validate import validate_config
+from vnrrt.pipeline import training_budget as budget
+from vnrrt.pipeline.evaluation import instances_settings, trials_settings
+from vnrrt.pipeline.paper_comparison import evaluate_settings, report_settings
+from vnrrt.pipeline.sampling_ideas import ideas_settings, part_settings
+from vnrrt.pipeline.validate import validate_config
 
 SETTINGS = {
     "instances": instances_settings,

@@ -1,7 +1,7 @@
-"""``python -m vnrrt``: the ``vnrrt`` command line (:mod:`vnrrt.cli`)."""
+"""``python -m vnrrt``: the ``vnrrt`` command line (:mod:`vnrrt.cli.main`)."""
 
 import sys
 
-from vnrrt.cli import main
+from vnrrt.cli.main import main
 
 sys.exit(main())

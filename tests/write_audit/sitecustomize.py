@@ -1,4 +1,4 @@
-"""Records what a pipeline stage script writes (tests/test_pipeline.py puts this folder on
+"""Records what a pipeline stage script writes (tests/pipeline/test_pipeline.py puts this folder on
 ``PYTHONPATH`` for ``dvc repro``): a process running ``stages/<name>.py`` snapshots the files
 under its working directory at start and at exit, and appends the files it created or changed
 to ``$VNRRT_WRITE_LOG`` as one JSON line ``{"argv": [...], "written": [...]}``. Other

@@ -18,9 +18,9 @@ from vnrrt.data.config import LabelsConfig
 from vnrrt.data.label import MapLabels, label_map
 from vnrrt.data.reader import TEST, TRAIN
 from vnrrt.data.shards import FORMAT_VERSION, meta_json, write_shard
+from vnrrt.infra.parallel import parallel_map
 from vnrrt.maps.config import DataConfig
 from vnrrt.maps.generate import FloorMap, generate_map, map_rng
-from vnrrt.parallel import parallel_map
 
 log = logging.getLogger(__name__)
 

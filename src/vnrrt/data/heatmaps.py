@@ -18,7 +18,7 @@ field               shape, dtype        meaning
 ``net_<network>``   (N, S, S) float16   that network's heatmaps, in ``keys`` order
 ==================  ==================  ==================================================
 
-The evaluation instances are :func:`vnrrt.data.datamodule.evaluation_keys`: ``R`` evenly
+The evaluation instances are :func:`vnrrt.data.splits.evaluation_keys`: ``R`` evenly
 spaced instances of the test split (test maps of the shards, in shard order).
 """
 
@@ -31,8 +31,8 @@ from pathlib import Path
 
 import numpy as np
 
-from vnrrt.io import atomic_write_bytes
-from vnrrt.paths import heatmaps_part_file as part_file
+from vnrrt.config.paths import heatmaps_part_file as part_file
+from vnrrt.infra.io import atomic_write_bytes
 
 FORMAT_VERSION = 2
 PREFIX = "net_"  # field name prefix of a network's heatmaps

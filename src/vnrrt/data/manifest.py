@@ -15,7 +15,7 @@ import numpy as np
 
 from vnrrt.data.reader import TEST, TRAIN, Shard
 from vnrrt.data.shards import FORMAT_VERSION, ShardError, shard_file
-from vnrrt.io import sha256, write_json
+from vnrrt.infra.io import sha256, write_json
 
 
 def shard_entry(path: Path) -> dict:

@@ -35,8 +35,8 @@ from pathlib import Path
 
 import numpy as np
 
-from vnrrt.io import atomic_write_bytes
-from vnrrt.paths import shard_file  # noqa: F401  (re-exported)
+from vnrrt.config.paths import shard_file  # noqa: F401  (re-exported)
+from vnrrt.infra.io import atomic_write_bytes
 
 FORMAT_VERSION = 1
 FIELDS = {

@@ -76,7 +76,7 @@ def target_mask(path: np.ndarray, vertices: np.ndarray, shape: tuple[int, int], 
 
 def label_masks(path: np.ndarray, vertices: np.ndarray, shape: tuple[int, int]) -> dict:
     """The undilated ``(H, W)`` bool masks the heatmap metrics compare against
-    (:func:`vnrrt.model.metrics.heatmap_metrics`): ``path`` (all path cells), ``vertices``
+    (:func:`vnrrt.predict.batch.heatmap_metrics`): ``path`` (all path cells), ``vertices``
     (start and goal included), ``interior`` (vertices without start and goal) and
     ``endpoints`` (start and goal)."""
     path = np.asarray(path, np.int64).reshape(-1, 2)

@@ -136,7 +136,7 @@ class StatsConfig:
 @conf_defaults("oracle")
 class OracleConfig:
     """The ``oracle`` section: the oracle families of the sampling-ideas study
-    (:mod:`vnrrt.evaluation.sampling_ideas`)."""
+    (:mod:`vnrrt.studies.sampling_ideas`)."""
 
     families: dict[str, list[str]]
     sigmas: list[float]

@@ -13,8 +13,8 @@ import numpy as np
 from vnrrt.data.instances import FORMAT_VERSION, InstancesError
 from vnrrt.data.reader import Shard
 from vnrrt.data.splits import evaluation_keys
-from vnrrt.io import atomic_write_bytes
-from vnrrt.parallel import parallel_map
+from vnrrt.infra.io import atomic_write_bytes
+from vnrrt.infra.parallel import parallel_map
 from vnrrt.planners.reference import taut_length
 from vnrrt.search import any_angle_path
 

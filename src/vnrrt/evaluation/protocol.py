@@ -64,7 +64,7 @@ def configurations(ev: Configurations, taus: list[float], tau: float) -> list[Co
     return keys
 
 
-# planner -> the GPU-trained paper network it samples (vnrrt.gpu.returned.NETWORKS' names)
+# planner -> the GPU-trained paper network it samples (vnrrt.data.returned.NETWORKS' names)
 GPU_SOURCES = {"nrrt_star": "paper_nrrtnet", "vnrrt_star": "paper_vertexnet",
                "m_vnrrt_star": "paper_vertexnet"}  # fmt: skip
 

@@ -16,8 +16,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from vnrrt.io import write_text
-from vnrrt.paths import table_part_file as part_file
+from vnrrt.config.paths import table_part_file as part_file
+from vnrrt.infra.io import write_text
 
 # Cost bounds (x reference length) whose first-reach time is recorded in optimal runs: the
 # convergence curve (cost versus time) of every trial.

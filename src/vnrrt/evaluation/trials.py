@@ -28,7 +28,7 @@ from vnrrt.evaluation.keys import ConfigKey
 from vnrrt.evaluation.protocol import TrialJob, trial_jobs, trial_seed
 from vnrrt.evaluation.sampling import build_sampler, free_rule
 from vnrrt.evaluation.table import CONVERGENCE_FACTORS, TrialRow, frame
-from vnrrt.parallel import parallel_map
+from vnrrt.infra.parallel import parallel_map
 from vnrrt.planners import PlannerConfig, plan, warmup
 
 

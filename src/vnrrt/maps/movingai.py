@@ -136,7 +136,7 @@ def write_map(path: str | Path, grid: np.ndarray) -> None:
     """Write a ``.map`` file (atomically). ``grid``: an occupancy ``(H, W)`` (bool or integer,
     nonzero = obstacle, written ``@``; free written ``.``) or a terrain array of ``<U1``
     characters (written as given)."""
-    from vnrrt.io import write_text
+    from vnrrt.infra.io import write_text
 
     arr = np.asarray(grid)
     if arr.dtype.kind == "U":
@@ -204,7 +204,7 @@ def write_scen(
     space-separated as the older files are; lengths with ``format(length, length_format)``
     (``'g'``, 6 significant digits, as the ``version 1`` files; ``'.2f'`` as ``version 1.0``;
     None: the shortest text that reads back as the same float)."""
-    from vnrrt.io import write_text
+    from vnrrt.infra.io import write_text
 
     if version not in VERSIONS:
         raise ValueError(f"version must be one of {VERSIONS}, got {version!r}")

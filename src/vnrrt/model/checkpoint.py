@@ -1,8 +1,9 @@
 """Checkpoints of trained networks: checking them before resuming, loading them to predict.
 
-A checkpoint is Lightning's file plus a ``"vnrrt"`` record (:func:`vnrrt.train.make_record`):
-the network's config, its target, the input rendering and a sha256 of the record and the
-weights (:func:`vnrrt.model.record.record_digest`, written when the file is saved). A
+A checkpoint is Lightning's file plus a ``"vnrrt"`` record
+(:func:`vnrrt.pipeline.training.make_record`): the network's config, its target, the input
+rendering and a sha256 of the record and the weights (:func:`vnrrt.model.record.record_digest`,
+written when the file is saved). A
 checkpoint is only ever used from an explicit path (config or DVC stage), never found by
 globbing.
 
@@ -73,7 +74,7 @@ def checksum_file(path: str | Path) -> Path:
 
 def write_checksum(path: str | Path) -> str:
     """Record the checkpoint's sha256 beside it; returns the digest."""
-    from vnrrt.io import sha256, write_text
+    from vnrrt.infra.io import sha256, write_text
 
     digest = sha256(path)
     write_text(checksum_file(path), f"{digest}  {Path(path).name}\n")
@@ -83,7 +84,7 @@ def write_checksum(path: str | Path) -> str:
 def verify_checksum(path: str | Path, required: bool = False) -> None:
     """Raise :class:`CheckpointError` when the checkpoint's bytes do not match its recorded
     sha256 (a corrupted or swapped file), or when ``required`` and none is recorded."""
-    from vnrrt.io import sha256
+    from vnrrt.infra.io import sha256
 
     record = checksum_file(path)
     if not record.is_file():

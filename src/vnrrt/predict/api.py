@@ -71,8 +71,8 @@ def _mlflow_source(uri: str) -> tuple[str, str]:
     names now (``models:/vnrrt-vertexnet@quick`` -> ``models:/vnrrt-vertexnet/3``), and the
     tracking store it is read from; the two together name one model, so that a cache keyed by
     them never returns another store's version 1 or an alias's previous version."""
-    from vnrrt import tracking
     from vnrrt.model.checkpoint import CheckpointError
+    from vnrrt.tracking import store as tracking
 
     store = tracking.tracking_uri()
     tracking.check_store(store)

@@ -11,14 +11,15 @@ the scale's experiment.
   A* and exact optimal lengths);
 * inputs: the networks' logged models and the instances file as a dataset with its DVC hash;
 * the tag ``md5/predict.json``, by which the evaluation run finds this run
-  (:mod:`vnrrt.lineage`).
+  (:mod:`vnrrt.tracking.lineage`).
 """
 
 from __future__ import annotations
 
 from pathlib import Path
 
-from vnrrt import lineage, tracking
+from vnrrt.tracking import lineage
+from vnrrt.tracking import store as tracking
 
 
 def predict_metrics(out: dict) -> dict[str, float]:

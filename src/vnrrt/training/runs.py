@@ -27,7 +27,7 @@ from __future__ import annotations
 import logging
 from pathlib import Path
 
-from vnrrt import tracking
+from vnrrt.tracking import store as tracking
 
 log = logging.getLogger(__name__)
 # flattened config keys (prefixes) that say where and how a run works, not what it learns
@@ -98,7 +98,7 @@ def start_run(logger_cfg: tracking.LoggerConfig, scale: str, network: str, recor
 def log_shards(client, run_id: str, scale: str, datamodule: dict) -> None:
     """The shards as one input dataset per split (module doc; ``datamodule``: the
     ``train.datamodule`` settings)."""
-    from vnrrt import lineage
+    from vnrrt.tracking import lineage
 
     manifest = Path(datamodule["manifest"])
     for split, context in SPLITS.items():
@@ -139,7 +139,7 @@ def log_model(logger_cfg: tracking.LoggerConfig, scale: str, network: str, check
     import mlflow
     import mlflow.pytorch
 
-    from vnrrt.io import sha256
+    from vnrrt.infra.io import sha256
     from vnrrt.model.checkpoint import load_network
 
     net, record = load_network(checkpoint, network)
@@ -174,7 +174,7 @@ def describe_run(network: str, scale: str, record: dict, tested: dict,
                  version: str | None) -> str:  # fmt: skip
     """The training run's markdown description: the network, its target, its test metrics
     and its registry version."""
-    from vnrrt.lineage import model_version_link
+    from vnrrt.tracking.lineage import model_version_link
 
     t = record["target"]
     lines = [

@@ -1,7 +1,7 @@
 """Fit one network with ready objects (a LightningModule, a DataModule and a Trainer) and
 write its outputs: the final checkpoint (atomically), the metrics JSON and, through the
-trainer's MLflow logger, the run. Nothing here reads configuration; :mod:`.stage` builds
-the objects from it.
+trainer's MLflow logger, the run. Nothing here reads configuration;
+:mod:`vnrrt.pipeline.training` builds the objects from it.
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ from pathlib import Path
 import lightning as L
 import torch
 
-from vnrrt.io import write_json
+from vnrrt.infra.io import write_json
 
 log = logging.getLogger(__name__)
 

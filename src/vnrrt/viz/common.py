@@ -13,7 +13,7 @@ import numpy as np
 from matplotlib.colors import ListedColormap, PowerNorm
 from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
-from vnrrt.io import atomic_write_bytes
+from vnrrt.infra.io import atomic_write_bytes
 
 OBSTACLES = ListedColormap([(0, 0, 0, 0), (0, 0, 0, 1)])  # free transparent, obstacle black
 HEAT_CMAP = "Blues"  # white (0) to dark blue (1): start (green) and goal (red) stay visible

@@ -10,8 +10,8 @@ import numpy as np
 import pandas as pd
 
 from vnrrt.evaluation.keys import is_informed, label
-from vnrrt.evaluation.sampling_ideas.summary import sweep_columns
 from vnrrt.names import level_name, stop_name
+from vnrrt.studies.sampling_ideas.summary import sweep_columns
 from vnrrt.viz.common import log_ticks, save_figure
 
 QUALITY_STOPS = ("initial", "optimal", "optimal_any_angle")
@@ -90,7 +90,7 @@ def quality_figure(
 
 def regime_figure(cells: pd.DataFrame, stop: str, settings: dict):
     """Speed-up over RRT* per regime cell (rows) and configuration run in every cell
-    (columns, :func:`vnrrt.evaluation.sampling_ideas.summary.sweep_columns`), log colour
+    (columns, :func:`vnrrt.studies.sampling_ideas.summary.sweep_columns`), log colour
     scale, ``*`` where the CI excludes 1; ``settings``: the study's ``eps`` and ``level``.
     Returns the figure."""
     eps = settings["eps"]

@@ -13,7 +13,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from vnrrt.io import write_text
+from vnrrt.infra.io import write_text
 
 DEFAULT_OUT = Path(".dvc/tmp/plots_offline.html")
 PAGE = """<!DOCTYPE html>

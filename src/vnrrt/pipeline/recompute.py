@@ -1,0 +1,162 @@
+"""Every number of both reports, recomputed from committed per-trial tables.
+
+``python -m vnrrt.pipeline.recompute export --params params.yaml --out reports/cpu/results``
+writes, from a finished run's files (its ``params.yaml``), the bundle of
+:data:`BUNDLE` (schema in the bundle's ``README.md``): the merged trial tables of the paper
+comparison, the oracle study and the regime sweep (gzip CSV, columns of
+:mod:`vnrrt.evaluation.table`), the instances' optimal lengths and named maps, the networks'
+``predict.json`` and training metrics, and the parameters.
+
+``python -m vnrrt.pipeline.recompute run --bundle reports/cpu/results --out <folder>``
+recomputes from the bundle alone (with the repository's ``data/paper/*.yaml``) the
+statistics (``summary.json``, ``ideas.json``), ``paper_comparison.md``,
+``sampling_ideas.md`` and ``headline.json``, through the functions the stages use: the same
+numbers, byte for byte (tested at smoke scale). Figures are not redrawn.
+"""
+
+from __future__ import annotations
+
+import argparse
+import gzip
+import shutil
+import sys
+from pathlib import Path
+
+from vnrrt.config import ConfigError, load_params, restrict, stage_params
+
+BUNDLE = {  # file -> what it holds
+    "params.yaml": "the run's parameters (the composed config)",
+    "trials.csv.gz": "the paper comparison's trials, one row per planner run",
+    "oracle.csv.gz": "the oracle study's trials",
+    "regime.csv.gz": "the regime sweep's trials",
+    "instances.json": "per map set the A*, exact and taut optimal lengths; the named maps",
+    "predict.json": "the networks' heatmap metrics, inference times and their settings",
+    "train.json": "each network's training metrics (steps, images, time, architecture; with "
+    "eval.gpu also the GPU-trained networks')",
+}
+
+
+def _view(cfg, stage: str):
+    from vnrrt.config import REPO_ROOT
+
+    return restrict(cfg, stage_params(stage, REPO_ROOT / "dvc.yaml"))
+
+
+def export(params: Path, out: Path) -> list[Path]:
+    """Write the bundle (module doc) of the run that ``params`` describes; returns its files."""
+    from vnrrt.data.instances import Instances
+    from vnrrt.evaluation.table import write_table
+    from vnrrt.infra.io import read_json, write_json
+    from vnrrt.pipeline.sampling_ideas import ideas_settings, ideas_tables
+
+    cfg = load_params(params)
+    s = ideas_settings(_view(cfg, "ideas"))
+    paths = s["paths"]
+    out.mkdir(parents=True, exist_ok=True)
+    shutil.copyfile(params, out / "params.yaml")
+    _gzip(Path(paths.trials_table), out / "trials.csv.gz")
+    for which, table in ideas_tables(s).items():
+        write_table(table, out / f"{which}.csv")
+        _gzip(out / f"{which}.csv", out / f"{which}.csv.gz")
+        (out / f"{which}.csv").unlink()
+    inst = Instances(paths.instances)
+    write_json(out / "instances.json", {"optima": inst.optima(), "named": inst.named()})
+    predict = read_json(paths.predict_metrics)
+    write_json(out / "predict.json", predict)
+    trainings = {n: read_json(paths.train_metrics(n)) for n in predict["networks"]}
+    if cfg.eval.get("gpu"):  # the report's GPU-trained rows, as stage report reads them
+        from vnrrt.pipeline.paper_comparison import gpu_trainings
+
+        trainings |= gpu_trainings(paths)
+    write_json(out / "train.json", trainings)
+    (out / "README.md").write_text(_schema())
+    return [out / name for name in (*BUNDLE, "README.md")]
+
+
+def _gzip(src: Path, dst: Path) -> None:
+    """``src`` compressed to ``dst`` (no timestamp in the header: the same bytes each time)."""
+    with (
+        open(src, "rb") as f,
+        open(dst, "wb") as raw,
+        gzip.GzipFile(fileobj=raw, mode="wb", mtime=0, filename="") as g,
+    ):
+        shutil.copyfileobj(f, g)
+
+
+def _schema() -> str:
+    from vnrrt.evaluation.table import COLUMNS, TrialRow
+
+    lines = ["# Per-trial results behind the committed reports", "", "| file | holds |",
+             "| --- | --- |", *[f"| `{k}` | {v} |" for k, v in BUNDLE.items()], "",
+             "Trial table columns (`vnrrt.evaluation.table.TrialRow`):", ""]  # fmt: skip
+    lines += [f"- `{c}`" for c in COLUMNS]
+    lines += ["", TrialRow.__doc__.strip(), "",
+              "Recompute every number of both reports: `python -m vnrrt.pipeline.recompute "
+              "run --bundle <this folder> --out <folder>`.", ""]  # fmt: skip
+    return "\n".join(lines)
+
+
+def recompute(bundle: Path, out: Path) -> list[Path]:
+    """Recompute the statistics and reports from the bundle alone (module doc) into
+    ``out``; returns the files written."""
+    from vnrrt.evaluation.table import read_table
+    from vnrrt.infra.io import read_json, write_json, write_text
+    from vnrrt.pipeline.paper_comparison import (
+        evaluate_settings,
+        evaluate_summary,
+        report_settings,
+        report_text,
+    )
+    from vnrrt.pipeline.sampling_ideas import ideas_settings, ideas_summary, ideas_text
+    from vnrrt.studies.paper_comparison.report import headline
+
+    missing = [n for n in BUNDLE if not (bundle / n).is_file()]
+    if missing:
+        raise ConfigError(f"results bundle {bundle} lacks {missing} (see its README.md)")
+    cfg = load_params(bundle / "params.yaml")
+    predict, trainings = read_json(bundle / "predict.json"), read_json(bundle / "train.json")
+    out.mkdir(parents=True, exist_ok=True)
+    summary = evaluate_summary(read_table(bundle / "trials.csv.gz"),
+                               evaluate_settings(_view(cfg, "evaluate")), predict)  # fmt: skip
+    write_json(out / "summary.json", summary)
+    summary = read_json(out / "summary.json")  # as the report stage reads it
+    rs = report_settings(_view(cfg, "report"))
+    optima = read_json(bundle / "instances.json")["optima"]
+    write_text(out / "paper_comparison.md", report_text(rs, summary, predict, trainings, optima))
+    write_json(out / "headline.json", headline(summary, predict["networks"]))
+    ids = ideas_settings(_view(cfg, "ideas"))
+    tables = {w: read_table(bundle / f"{w}.csv.gz") for w in ("oracle", "regime")}
+    write_json(out / "ideas.json", ideas_summary(tables, ids))
+    write_text(out / "sampling_ideas.md", ideas_text(read_json(out / "ideas.json"), ids))
+    names = ("summary.json", "paper_comparison.md", "headline.json", "ideas.json")
+    return [out / n for n in (*names, "sampling_ideas.md")]
+
+
+def main(argv: list[str] | None = None) -> int:
+    """The command line (module doc); returns the exit status."""
+    parser = argparse.ArgumentParser(prog="python -m vnrrt.pipeline.recompute",
+                                     description=__doc__.split("\n\n")[0])  # fmt: skip
+    sub = parser.add_subparsers(dest="command", required=True)
+    ex = sub.add_parser("export", help="write the results bundle of a finished run")
+    ex.add_argument("--params", type=Path, default=Path("params.yaml"))
+    ex.add_argument("--out", type=Path, required=True)
+    rc = sub.add_parser("run", help="recompute both reports from a results bundle")
+    rc.add_argument("--bundle", type=Path, required=True)
+    rc.add_argument("--out", type=Path, required=True)
+    args = parser.parse_args(argv)
+    try:
+        files = (
+            export(args.params, args.out)
+            if args.command == "export"
+            else recompute(args.bundle, args.out)
+        )
+    except (ConfigError, OSError, ValueError) as err:
+        print(f"vnrrt.pipeline.recompute: error: {err}".splitlines()[0], file=sys.stderr)
+        return 2
+    for f in files:
+        print(f)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,149 @@
+"""The paper's quoted claims judged as a referee would (stage ``evaluate``).
+
+* **One verdict per claim.** A claim is read on time (its own metric, the verdict) and on
+  iterations (a second reading, shown beside it), both paired and clustered
+  (:func:`vnrrt.evaluation.stats.compare`), at the family-wise level over the claims tested
+  (Bonferroni: ``1 - (1 - level) / claims``), with enough bootstrap resamples that each tail
+  of the corrected interval holds ``stats.tail_draws`` draws.
+* **The paper's own noise.** Each claim's interval from the paper's means, sds and trial
+  counts (:mod:`.paper_noise`), at the same corrected level. Our ratio of means (the paper's
+  estimand) is *compatible with the paper's data* when its interval overlaps the paper's,
+  and *contradicts* it when they are disjoint.
+* **What a masked claim tests.** Where M-VNRRT*'s sampler puts its mass after the mask
+  (start/goal disks, interior vertices, the rest of the path) and how often it falls back to
+  uniform sampling (:func:`mask_shares`); a claim whose masked sampler is mostly on the
+  start/goal disks or mostly falls back is *not testable with this network*
+  (:func:`testability`).
+"""
+
+from __future__ import annotations
+
+import math
+
+import pandas as pd
+
+from vnrrt.evaluation.keys import ConfigKey
+from vnrrt.evaluation.stats import bonferroni_level, compare, verdict
+from vnrrt.studies.paper_comparison.paper_noise import claim_interval
+
+SHARES = ("mass_endpoints", "mass_interior", "mass_path")
+COMPATIBLE, CONTRADICTS = "compatible with the paper's data", "contradicts the paper's data"
+
+
+def improvement(c: dict, lo: str = "ci_low", hi: str = "ci_high", mid: str = "speedup") -> str:
+    """A reading's improvement (ratio - 1) with its interval, as the report and the
+    dashboard show it: ``+12.3% [+1.0%, +25.0%]``."""
+    return f"{c[mid] - 1:+.1%} [{c[lo] - 1:+.1%}, {c[hi] - 1:+.1%}]"
+
+
+def verdict_text(row: dict) -> str:
+    """A claim's verdict in the report's words (the dashboard's too): with the iterations'
+    verdict where it differs from the time reading's (``no clear effect; on iterations:
+    reproduced``), and ``different map: not comparable (...)`` off the comparable column."""
+    text, it = row["verdict"], row.get("iterations")
+    if row.get("time_to_stop") and it and it["verdict"] != text:
+        text = f"{text}; on iterations: {it['verdict']}"
+    return text if row["comparable"] else f"different map: not comparable ({text})"
+
+
+def mask_shares(table: pd.DataFrame) -> dict:
+    """``{stop: {key: {map_set: {mass_endpoints, mass_interior, mass_path, fallback_rate,
+    instances}}}}`` for every configuration with a heatmap: the shares averaged over
+    instances (one value per instance), the fallback rate over trials."""
+    out: dict = {}
+    heat = table[table["source"] != ""]
+    for (stop, key, map_set), sub in heat.groupby(["stop", "key", "map_set"], sort=False):
+        per_instance = sub.groupby("instance")[list(SHARES)].first()
+        cell = {s: _mean(per_instance[s]) for s in SHARES}
+        cell["fallback_rate"] = float(sub["fallback_uniform"].mean())
+        cell["instances"] = int(len(per_instance))
+        out.setdefault(stop, {}).setdefault(key, {})[map_set] = cell
+    return out
+
+
+def _mean(values: pd.Series) -> float | None:
+    v = values.dropna()
+    return float(v.mean()) if len(v) else None
+
+
+def testability(cell: dict | None, max_endpoints: float, max_fallback: float) -> dict:
+    """Whether a masked claim tests the mask (``cell``: its :func:`mask_shares` entry): not
+    when more than ``max_endpoints`` of its sampler's mass lies on the start/goal disks or
+    it falls back to uniform in more than ``max_fallback`` of the trials."""
+    if cell is None:
+        return {"testable": True, "why": ""}
+    why = []
+    ends = cell.get("mass_endpoints")
+    if ends is not None and ends > max_endpoints:
+        why.append(f"{ends:.0%} of its sampler's mass is on the start/goal disks")
+    if cell["fallback_rate"] > max_fallback:
+        why.append(f"it falls back to uniform sampling in {cell['fallback_rate']:.0%} of trials")
+    return {"testable": not why, "why": "; ".join(why)}
+
+
+def compatibility(ours_low: float, ours_high: float, paper_low: float, paper_high: float) -> str:
+    """:data:`COMPATIBLE` when the two intervals of the improvement overlap, else
+    :data:`CONTRADICTS` (NaN bounds: compatible, nothing shown against it)."""
+    if not all(math.isfinite(v) for v in (ours_low, ours_high)):
+        return COMPATIBLE
+    return COMPATIBLE if ours_low <= paper_high and paper_low <= ours_high else CONTRADICTS
+
+
+def _pair(table: pd.DataFrame, paper: dict, claim: dict):
+    """(baseline rows, planner rows) of a claim's table column; None if either is missing."""
+    stop = paper["tables"][claim["table"]]["stop"]
+    sel = table[(table["stop"] == stop) & (table["map_set"] == claim["column"])]
+    base, plan = sel[sel["key"] == claim["baseline"]], sel[sel["key"] == claim["planner"]]
+    return None if base.empty or plan.empty else (base, plan)
+
+
+def claim_boot(n_boot: int, tail_draws: int, level: float) -> int:
+    """Resamples for intervals at ``level``: at least ``n_boot``, and enough that each tail
+    holds ``tail_draws`` draws."""
+    return max(n_boot, math.ceil(tail_draws / ((1 - level) / 2) - 1e-6))  # float noise
+
+
+def _reading(pair, claim: dict, metric: str, n_boot: int, level: float) -> dict:
+    c = compare(*pair, metric, n_boot=n_boot, level=level).as_dict()
+    c["verdict"] = verdict(claim["quoted"], c["ci_low"] - 1, c["ci_high"] - 1)
+    return c
+
+
+def claims(table: pd.DataFrame, paper: dict, st, shares: dict) -> dict:
+    """Every quoted claim with its readings, the paper's interval, the compatibility and
+    testability verdicts (module doc); ``st``: the ``stats`` section
+    (:class:`vnrrt.evaluation.config.StatsConfig`); ``shares``: :func:`mask_shares`. The
+    table may hold ``time_total`` (planning + inference, s): a third reading."""
+    comparable = set(paper.get("comparable_columns", []))
+    pairs = [_pair(table, paper, claim) for claim in paper["claims"]]
+    tested = sum(p is not None for p in pairs)
+    strict = bonferroni_level(st.level, tested)
+    n_boot = claim_boot(st.bootstrap, st.tail_draws, strict)
+    metrics = ["time_to_stop", "iterations"] + (["time_total"] if "time_total" in table else [])
+    rows = []
+    for claim, pair in zip(paper["claims"], pairs, strict=True):
+        stop = paper["tables"][claim["table"]]["stop"]
+        iv = claim_interval(paper, claim, strict)
+        row = {**claim, "comparable": claim["column"] in comparable, "paper": iv.as_dict()}
+        for m in metrics:
+            row[m] = None if pair is None else _reading(pair, claim, m, n_boot, strict)
+        t = row["time_to_stop"]
+        row["verdict"] = "no data" if t is None else t["verdict"]
+        row["paper_data"] = (
+            None
+            if t is None
+            else compatibility(t["rom_ci_low"] - 1, t["rom_ci_high"] - 1, iv.low, iv.high)
+        )
+        masked = ConfigKey.parse(claim["planner"]).tau is not None
+        cell = (
+            shares.get(stop, {}).get(claim["planner"], {}).get(claim["column"]) if masked else None
+        )
+        row["testability"] = testability(cell, st.untestable_endpoint_share, st.untestable_fallback)
+        rows.append(row)
+    tails = n_boot * (1 - strict) / 2
+    rule = (f"more than {st.untestable_endpoint_share:.0%} of its sampler's mass lies on the "
+            f"start/goal disks, or it falls back to uniform sampling in more than "
+            f"{st.untestable_fallback:.0%} of its trials")  # fmt: skip
+    return {"level": st.level, "claims": tested, "corrected_level": strict,
+            "bootstrap": n_boot, "tail_draws": tails, "testability_rule": rule,
+            "rows": rows}  # fmt: skip

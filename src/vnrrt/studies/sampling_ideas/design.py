@@ -1,0 +1,198 @@
+"""What the sampling-ideas study runs (settings in :mod:`vnrrt.evaluation.config`: ``oracle``,
+``regime``).
+
+* **Instances.** The first ``oracle.random_maps`` random test instances, split by base map
+  (:func:`split_instances`): ``oracle.selection_share`` of the maps select, the others
+  evaluate; no base map is in both.
+* **Selection** (stage ``oracle@<k>``): on the selection instances, RRT* and every member of
+  every oracle family (:func:`family_members`): each target of ``oracle.families`` at each blur
+  of ``oracle.sigmas`` and heatmap-draw probability of ``oracle.mixes``, and the path-vertex
+  blend (:func:`vnrrt.evaluation.oracles.blend`) at each ``oracle.blend_weights`` x blur x
+  mix, all through the heatmap sampler; every stop rule, ``oracle.trials`` trials each. Each
+  family's best member per stop rule (the most RRT* iterations saved,
+  :func:`vnrrt.studies.sampling_ideas.selection.select`) is its **envelope**.
+* **Evaluation** (stage ``regime@<k>``): on the evaluation instances, in the protocol's cell
+  and in every other cell of ``regime.etas x`` radius rules ``x regime.goal_radii``
+  (:func:`regime_cells`; one with the protocol's own settings is the protocol's): RRT*,
+  ``regime.configurations`` (the trained networks), every envelope and the blend at every
+  weight (at the blend envelope's blur and mix); the
+  protocol's cell also runs the quality curve (each path and vertex envelope diluted to signal
+  fraction ``oracle.qualities``, :func:`vnrrt.evaluation.oracles.dilute`) and every
+  configuration under the other obstacle rule (``+free``).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from vnrrt.evaluation.config import Configurations, OracleConfig, RegimeConfig
+from vnrrt.evaluation.keys import ConfigKey
+from vnrrt.evaluation.oracles import BLEND, OracleSource
+from vnrrt.evaluation.protocol import STOPS
+
+PROTOCOL = "protocol"  # the regime cell of the protocol's own planner settings
+IDEA_PLANNER = {"path": "nrrt_star"}  # path oracles are NRRT*'s idea; the others VNRRT*'s
+QUALITY_IDEAS = ("path", "vertex")  # the families of the quality curve
+
+
+def split_instances(
+    instances: list[int], clusters: list[int], share: float, seed: int
+) -> tuple[list[int], list[int]]:
+    """``(selection, evaluation)`` instances: the base maps (``clusters[i]`` of instance
+    ``instances[i]``) shuffled with ``seed``, the first ``share`` of them (at least one, at
+    most all but one) select."""
+    maps = sorted(set(clusters))
+    if len(maps) < 2:
+        raise ValueError(f"the oracle study needs instances of 2 base maps or more, got {maps}")
+    order = np.random.default_rng([seed, 0x5E1EC7]).permutation(len(maps))
+    n = min(max(1, round(share * len(maps))), len(maps) - 1)
+    chosen = {maps[i] for i in order[:n]}
+    sel = [i for i, c in zip(instances, clusters, strict=True) if c in chosen]
+    ev = [i for i, c in zip(instances, clusters, strict=True) if c not in chosen]
+    return sel, ev
+
+
+def member(idea: str, source: OracleSource, mix: float) -> ConfigKey:
+    """The configuration sampling oracle ``source`` with heatmap-draw probability ``mix``."""
+    return ConfigKey(IDEA_PLANNER.get(idea, "vnrrt_star"), mix=mix).with_source(source.text)
+
+
+def family_members(oc: OracleConfig) -> dict[str, list[ConfigKey]]:
+    """``{idea: members}``: every family of ``oracle.families`` and the ``blend`` (module
+    doc), in a fixed order."""
+    out = {}
+    for idea, kinds in oc.families.items():
+        out[idea] = [
+            member(idea, OracleSource(k, s), m) for k in kinds for s in oc.sigmas for m in oc.mixes
+        ]
+    out["blend"] = [
+        member("blend", OracleSource(BLEND, s, w=w), m)
+        for w in oc.blend_weights
+        for s in oc.sigmas
+        for m in oc.mixes
+    ]
+    return out
+
+
+def selection_keys(oc: OracleConfig) -> list[ConfigKey]:
+    """RRT* and every family member (module doc), each once."""
+    keys = [ConfigKey("rrt_star")]
+    for members in family_members(oc).values():
+        keys += members
+    return list(dict.fromkeys(keys))
+
+
+def idea_of(key: ConfigKey, families: dict[str, list[str]]) -> str | None:
+    """The family a configuration's oracle belongs to (``blend`` for the blend; None for
+    networks and RRT*)."""
+    if not key.named_source or not key.source.startswith("oracle_"):
+        return None
+    kind = OracleSource.parse(key.source).kind
+    if kind == BLEND:
+        return "blend"
+    return next((idea for idea, kinds in families.items() if kind in kinds), None)
+
+
+def blend_at(key: ConfigKey, w: float) -> ConfigKey:
+    """The blend configuration ``key`` at weight ``w`` (same blur and mix)."""
+    o = OracleSource.parse(key.source)
+    return key.with_source(OracleSource(BLEND, o.sigma, o.q, w).text)
+
+
+def diluted(key: ConfigKey, q: float) -> ConfigKey:
+    """An oracle configuration ``key`` at signal fraction ``q`` (the quality curve)."""
+    o = OracleSource.parse(key.source)
+    return key.with_source(OracleSource(o.kind, o.sigma, q, o.w).text)
+
+
+def evaluation_keys(
+    envelopes: dict, oc: OracleConfig, rc: RegimeConfig, ev: Configurations, protocol: dict
+) -> dict[str, list[ConfigKey]]:
+    """``{cell: keys}`` of the evaluation (module doc); ``envelopes``: ``{stop: {idea: key
+    text}}`` (:func:`vnrrt.studies.sampling_ideas.selection.select`); ``protocol``: the
+    protocol cell's settings (:func:`protocol_settings`)."""
+    chosen = list(
+        dict.fromkeys(ConfigKey.parse(t) for per in envelopes.values() for t in per.values())
+    )
+    blends = [k for k in chosen if idea_of(k, oc.families) == "blend"]
+    blends = [blend_at(k, w) for k in blends for w in oc.blend_weights]
+    base = [ConfigKey("rrt_star"), *(ConfigKey.parse(t, ev.sources) for t in rc.configurations)]
+    every = list(dict.fromkeys([*base, *chosen, *blends]))
+    quality = [
+        diluted(k, q)
+        for k in chosen
+        if idea_of(k, oc.families) in QUALITY_IDEAS
+        for q in oc.qualities
+        if q != 1.0
+    ]
+    flipped = [k.with_free(not ev.zero_obstacles) for k in [*base, *chosen]]
+    cells = {PROTOCOL: list(dict.fromkeys([*every, *quality, *flipped]))}
+    cells |= {label: every for label in regime_cells(rc, protocol)}
+    return cells
+
+
+def oracle_counts(oc: OracleConfig) -> dict[tuple[str, str], int]:
+    """Trials per selection instance for every stop rule."""
+    return {("random", stop): oc.trials for stop in STOPS}
+
+
+def evaluation_counts(rc: RegimeConfig, cell: str) -> dict[tuple[str, str], int]:
+    """Trials per evaluation instance: every stop rule in the protocol's cell, the two
+    optimal ones in the others."""
+    stops = STOPS if cell == PROTOCOL else ("optimal", "optimal_any_angle")
+    return {("random", stop): rc.trials for stop in stops}
+
+
+def radius_rules(rc: RegimeConfig) -> list[tuple[str, dict]]:
+    """``(label, planner overrides)`` of each near-radius rule: ``shrinking`` at every
+    ``regime.gamma_factors`` (``shrinking*0.1``), ``fixedK`` (K x eta)."""
+    out = []
+    for mode in rc.radius_modes:
+        if mode == "shrinking":
+            out += [
+                (
+                    "shrinking" if g == 1.0 else f"shrinking*{g:g}",
+                    {"radius_mode": "shrinking", "gamma_factor": float(g)},
+                )
+                for g in rc.gamma_factors
+            ]
+        else:
+            out.append((mode, {"radius_mode": "fixed", "fixed_factor": int(mode[len("fixed") :])}))
+    return out
+
+
+CELL_SETTINGS = ("eta", "radius_mode", "gamma_factor", "fixed_radius", "goal_radius")
+"""The planner settings a regime cell overrides (``planner.<name>``)."""
+
+
+def protocol_settings(planner) -> dict:
+    """``{name: value}`` of :data:`CELL_SETTINGS` in ``planner`` (a
+    :class:`~vnrrt.planners.config.PlannerConfig` or the config's ``planner`` section): the
+    protocol's cell."""
+    return {k: getattr(planner, k) for k in CELL_SETTINGS}
+
+
+def regime_cells(rc: RegimeConfig, protocol: dict) -> dict[str, dict]:
+    """``{label: planner overrides}`` of every cell besides the protocol's, e.g.
+    ``eta=5 radius=shrinking*0.1 goal=inf``: ``{"eta": 5.0, "radius_mode": "shrinking",
+    "gamma_factor": 0.1, "goal_radius": inf}``. Left out: an unlimited step with a fixed
+    radius (every node near), and the cell whose overrides all equal ``protocol``'s settings
+    (:func:`protocol_settings`): it would repeat the protocol cell's runs exactly (the same
+    seeds; the study's counts would count that setting twice)."""
+    cells = {}
+    for eta in rc.etas:
+        for name, rule in radius_rules(rc):
+            over = dict(rule)
+            if "fixed_factor" in over:
+                if math.isinf(eta):
+                    continue
+                over["fixed_radius"] = float(eta) * over.pop("fixed_factor")
+            for goal in rc.goal_radii:
+                goal_label = "eta" if goal is None else f"{goal:g}"
+                g = None if goal is None else float(goal)
+                cell = {"eta": float(eta), "goal_radius": g, **over}
+                if any(protocol[k] != v for k, v in cell.items()):
+                    cells[f"eta={eta:g} radius={name} goal={goal_label}"] = cell
+    return cells

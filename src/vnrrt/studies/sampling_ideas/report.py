@@ -1,0 +1,418 @@
+"""``reports/sampling_ideas.md``: what each sampling idea can give (oracle families, their
+envelopes chosen on selection instances and reported on evaluation instances, the
+path-vertex blend, the heatmap-quality curve, the obstacle rule, the planner regime) and a
+conclusion computed from the numbers. A renderer of
+:func:`vnrrt.studies.sampling_ideas.summary.analyze_study`'s summary; every setting it names
+(tolerance, CI level, mass radius, the obstacle rule) comes from the summary's ``settings``."""
+
+from __future__ import annotations
+
+import math
+
+from vnrrt.evaluation.keys import ConfigKey, label
+from vnrrt.names import level_name, percent, stop_name
+from vnrrt.studies.sampling_ideas.design import PROTOCOL
+from vnrrt.studies.sampling_ideas.summary import sweep_columns
+
+IDEAS = ("path", "vertex", "blend", "control")
+OPTIMAL_STOPS = ("optimal", "optimal_any_angle")
+
+
+def _x(s: dict | None) -> str:
+    if not s or s.get("speedup") is None or not math.isfinite(s["speedup"]):
+        return "—"
+    lo, hi = s.get("ci_low"), s.get("ci_high")
+    if lo is None or not math.isfinite(lo):
+        return f"{s['speedup']:.2f}x"
+    return f"{s['speedup']:.2f}x [{lo:.2f}, {hi:.2f}]"
+
+
+def _pct(v) -> str:
+    return "—" if v is None or not math.isfinite(v) else f"{100 * v:.1f}%"
+
+
+def _word(s: dict, better: str, worse: str, same: str) -> str:
+    """``better`` when the CI lies above 1, ``worse`` below, else ``same`` (never a gain
+    for an interval that contains 1)."""
+    if s["ci_low"] is not None and s["ci_low"] > 1:
+        return better
+    if s["ci_high"] is not None and s["ci_high"] < 1:
+        return worse
+    return same
+
+
+def _cell(summary: dict, cell: str, stop: str, text: str | None) -> dict | None:
+    return next(
+        (
+            r
+            for r in summary["cells"]
+            if (r["regime"], r["stop"], r["configuration"]) == (cell, stop, text)
+        ),
+        None,
+    )
+
+
+def _envelope_findings(summary: dict, stop: str, eps: float) -> list[str]:
+    env = summary["selection"]["envelopes"].get(stop, {})
+    rows = {
+        r["idea"]: r for r in summary["envelopes"] if r["regime"] == PROTOCOL and r["stop"] == stop
+    }
+    out = []
+    cells = {i: _cell(summary, PROTOCOL, stop, env.get(i)) for i in IDEAS}
+    said = "; ".join(f"{i} {_x((cells[i] or {}).get('iterations'))}" for i in IDEAS if cells[i])
+    if said:
+        out.append(
+            f"Envelopes ({stop_name(stop, eps)}, the protocol's cell, fewer iterations "
+            f"than RRT*): {said}."
+        )
+    if "vertex" in rows:
+        v = rows["vertex"]["iterations"]
+        word = _word(v, "fewer iterations than", "more iterations than", "no clear difference from")
+        out.append(
+            f"Sampling near the turning points (the vertex envelope) needs {word} "
+            f"sampling near the path (the path envelope): {_x(v)} ({stop_name(stop, eps)})."
+        )
+    return out
+
+
+def cells_by_winner(summary: dict, stop: str, idea: str = "vertex") -> dict[str, list[str]]:
+    """``{"path": cells, idea: cells, "unclear": cells}``: the regime cells (in the study's
+    order) where the path envelope needs clearly fewer iterations than the ``idea`` envelope
+    (their paired ratio's CI below 1), where ``idea``'s needs clearly fewer (CI above 1), and
+    the others."""
+    out: dict[str, list[str]] = {"path": [], idea: [], "unclear": []}
+    rows = {
+        r["regime"]: r["iterations"]
+        for r in summary["envelopes"]
+        if r["stop"] == stop and r["idea"] == idea
+    }
+    for cell in summary["cell_names"]:
+        if cell in rows:
+            out[_word(rows[cell], idea, "path", "unclear")].append(cell)
+    return out
+
+
+def _winner_finding(summary: dict, stop: str, eps: float) -> list[str]:
+    won = cells_by_winner(summary, stop)
+    n = sum(len(v) for v in won.values())
+    if not n:
+        return []
+
+    def named(cells: list[str]) -> str:
+        return f" ({'; '.join(cells)})" if cells else ""
+
+    return [
+        f"Path envelope against vertex envelope, per regime cell ({stop_name(stop, eps)}): "
+        f"the path envelope needs clearly fewer iterations in {len(won['path'])} of {n} "
+        f"cells{named(won['path'])}; the vertex envelope in {len(won['vertex'])}"
+        f"{named(won['vertex'])}; no clear difference in {len(won['unclear'])}."
+    ]
+
+
+def censored_cells(summary: dict, stop: str) -> list[tuple[str, float, float, str]]:
+    """``(cell, RRT*'s share, the lowest share, its configuration)`` for every regime cell
+    where some runs did not reach ``stop`` within the planner's budget, in the study's
+    order."""
+    out = []
+    for cell in summary["cell_names"]:
+        rows = [r for r in summary["cells"] if r["regime"] == cell and r["stop"] == stop]
+        low = min(rows, key=lambda r: r["success_rate"], default=None)
+        if low is None or low["success_rate"] >= 1.0:
+            continue
+        base = next((r for r in rows if r["configuration"] == "rrt_star"), None)
+        rrt = base["success_rate"] if base else math.nan
+        out.append((cell, rrt, low["success_rate"], low["configuration"]))
+    return out
+
+
+def budget_table(summary: dict, stop: str) -> str:
+    """The cells with runs stopped by the budget (:func:`censored_cells`)."""
+    rows = censored_cells(summary, stop)
+    if not rows:
+        return "Every run of every cell reached the stop rule within the budget."
+    lines = [
+        "Runs that reached the stop rule within the budget, where some did not (the others "
+        "enter the statistics at the budget, censored: RRT*'s censored runs make a speed-up a "
+        "lower bound, the planner's an upper bound):",
+        "",
+        "| cell | RRT* | lowest | its configuration |",
+        "| --- | --- | --- | --- |",
+    ]
+    lines += [f"| {c} | {_pct(r)} | {_pct(lo)} | {label(k)} |" for c, r, lo, k in rows]
+    return "\n".join(lines)
+
+
+def conclusion(summary: dict) -> list[str]:
+    """Plain-language findings computed from the summary (module doc)."""
+    st, out = summary["settings"], []
+    eps = st["eps"]
+    for stop in OPTIMAL_STOPS:
+        out += _envelope_findings(summary, stop, eps)
+        out += _winner_finding(summary, stop, eps)
+        w0 = summary["w0"].get(stop)
+        if w0:
+            out.append(
+                f"Does w = 0 (the path oracle) win at every step size ({stop_name(stop, eps)})? "
+                + (
+                    "Yes: no blend with w > 0 needs clearly fewer iterations in any cell."
+                    if w0["w0_wins_everywhere"]
+                    else "No: a blend with w > 0 needs clearly fewer iterations in "
+                    + ", ".join(w0["blend_wins"])
+                    + "."
+                )
+            )
+    for r in summary["networks"]:
+        if r["stop"] != "optimal":
+            continue
+        s = r["iterations"]
+        word = _word(
+            s,
+            "above its family's envelope (the family is incomplete: a member "
+            "this good was not among the oracles)",
+            "below its family's envelope",
+            "not clearly different from its family's envelope",
+        )
+        out.append(
+            f"The trained {label(r['configuration'])} is {word}: {_x(s)} of the "
+            f"{r['idea']} envelope's iterations saved ({stop_name('optimal', eps)})."
+        )
+    out += quality_needed(summary, eps)
+    for c in summary["regime_claims"]:
+        n = len(c["holds"]) + len(c["reversed"]) + len(c["unclear"])
+        out.append(
+            f"{c['claim']} ({stop_name(c['stop'], eps)}): holds in {len(c['holds'])} of "
+            f"{n} cells, reversed in {len(c['reversed'])}, unclear in {len(c['unclear'])}."
+        )
+    return out
+
+
+def quality_needed(summary: dict, eps: float) -> list[str]:
+    """Per idea: the heatmap quality (mass near the target, x a uniform map's) from which the
+    iteration speed-up's CI lies above 1 at that quality and every better one, from the
+    q > 0 points; "none needed" when q = 0 (a uniform map) already clears."""
+    out = []
+    for idea in ("path", "vertex"):
+        rows = [
+            r
+            for r in summary["curves"]
+            if r["idea"] == idea
+            and r["stop"] == "optimal"
+            and r["metric"] == "iterations"
+            and r["own"]
+        ]
+        if not rows:
+            continue
+        zero = [r for r in rows if r["q"] == 0.0]
+        if zero and zero[0]["ci_low"] is not None and zero[0]["ci_low"] > 1:
+            out.append(f"{idea} oracle: none needed (a uniform map already clears RRT*).")
+            continue
+        need = None
+        for r in sorted((r for r in rows if r["q"] > 0), key=lambda r: -r["q"]):
+            if r["ci_low"] is None or r["ci_low"] <= 1:
+                break
+            need = r
+        said = (
+            "never at these q"
+            if need is None
+            else (f"{need['x_uniform']:.1f}x a uniform map's mass (q = {need['q']:g})")
+        )
+        out.append(
+            f"Heatmap quality the {idea} idea needs for a clear gain over RRT* in "
+            f"iterations ({stop_name('optimal', eps)}; its envelope diluted): {said}."
+        )
+    return out
+
+
+def selection_table(summary: dict, stop: str) -> str:
+    """Per family: members tried, the envelope chosen and its selection speed-up."""
+    sel = summary["selection"]
+    lines = [
+        "| family | members | envelope (chosen) | its speed-up on the selection |",
+        "| --- | --- | --- | --- |",
+    ]
+    for idea, cells in sel["speedups"].get(stop, {}).items():
+        chosen = sel["envelopes"].get(stop, {}).get(idea)
+        if chosen:
+            lines.append(f"| {idea} | {len(cells)} | {label(chosen)} | {cells[chosen]:.2f}x |")
+    return "\n".join(lines)
+
+
+def envelope_table(summary: dict, stop: str) -> str:
+    """Per regime cell: each envelope's iteration speed-up over RRT* and the vertex and
+    blend envelopes against the path envelope."""
+    env = summary["selection"]["envelopes"].get(stop, {})
+    vs = {
+        (r["regime"], r["idea"]): r["iterations"] for r in summary["envelopes"] if r["stop"] == stop
+    }
+    head = "| cell | " + " | ".join(IDEAS) + " | vertex / path | blend / path |"
+    lines = [head, "|" + " --- |" * (len(IDEAS) + 3)]
+    for cell in summary["cell_names"]:
+        got = [_x((_cell(summary, cell, stop, env.get(i)) or {}).get("iterations")) for i in IDEAS]
+        if all(g == "—" for g in got):
+            continue
+        lines.append(
+            f"| {cell} | " + " | ".join(got) + f" | {_x(vs.get((cell, 'vertex')))} | "
+            f"{_x(vs.get((cell, 'blend')))} |"
+        )
+    return "\n".join(lines)
+
+
+def blend_table(summary: dict, stop: str) -> str:
+    """Per cell: the blend at each w > 0 against w = 0 (fewer iterations: above 1)."""
+    rows = [b for b in summary["blend"] if b["stop"] == stop]
+    weights = sorted({b["w"] for b in rows})
+    if not weights:
+        return "(not run)"
+    lines = [
+        "| cell | " + " | ".join(f"w = {w:g}" for w in weights) + " |",
+        "|" + " --- |" * (len(weights) + 1),
+    ]
+    for cell in summary["cell_names"]:
+        got = {b["w"]: b["iterations"] for b in rows if b["regime"] == cell}
+        if got:
+            lines.append(f"| {cell} | " + " | ".join(_x(got.get(w)) for w in weights) + " |")
+    return "\n".join(lines)
+
+
+def quality_table(summary: dict, stop: str) -> str:
+    """The quality curve: per idea, envelope diluted (every stop rule's, ``*`` marking this
+    stop rule's own) and q, the heatmap's mass near the target (x uniform) and the iteration
+    speed-up over RRT*."""
+    rows = [r for r in summary["curves"] if r["stop"] == stop and r["metric"] == "iterations"]
+    if not rows:
+        return "(not run)"
+    lines = [
+        "| idea | envelope diluted | q | mass near target | x a uniform map's | "
+        "speed-up, iterations |",
+        "| --- | --- | --- | --- | --- | --- |",
+    ]
+    for r in sorted(rows, key=lambda r: (r["idea"], not r["own"], r["member"], -r["q"])):
+        x = "—" if r["x_uniform"] is None else f"{r['x_uniform']:.1f}x"
+        name = label(r["member"]) + (" *" if r["own"] else "")
+        lines.append(
+            f"| {r['idea']} | {name} | {r['q']:g} | {_pct(r['heat_mass'])} | {x} | {_x(r)} |"
+        )
+    return "\n".join(lines)
+
+
+def rule_table(summary: dict, stop: str) -> str:
+    """The protocol cell's configurations under both obstacle rules (speed-up over RRT* under
+    the same rule, iterations)."""
+    rows = [
+        r
+        for r in summary["cells"]
+        if r["regime"] == PROTOCOL
+        and r["stop"] == stop
+        and "iterations" in r
+        and "@q" not in r["configuration"]
+    ]
+    by = {}
+    for r in rows:
+        key = ConfigKey.parse(r["configuration"])
+        by.setdefault(key.with_free(False).text, {})[key.free] = r["iterations"]
+    pairs = {k: v for k, v in by.items() if len(v) == 2}
+    if not pairs:
+        return "(not run)"
+    lines = ["| configuration | every cell | free cells only |", "| --- | --- | --- |"]
+    lines += [f"| {label(k)} | {_x(v[False])} | {_x(v[True])} |" for k, v in pairs.items()]
+    return "\n".join(lines)
+
+
+def regime_section(summary: dict, stop: str) -> str:
+    """Time speed-up over RRT* per cell (rows) and configuration run in every cell
+    (columns, :func:`.summary.sweep_columns`)."""
+    rows = [r for r in summary["regime"] if r["stop"] == stop]
+    if not rows:
+        return "(not run)"
+    confs = sweep_columns(rows)
+    lines = [
+        "| cell | " + " | ".join(label(c) for c in confs) + " |",
+        "|" + " --- |" * (len(confs) + 1),
+    ]
+    for cell in dict.fromkeys(r["regime"] for r in rows):
+        got = {r["configuration"]: r for r in rows if r["regime"] == cell}
+        lines.append(f"| {cell} | " + " | ".join(_x(got.get(c)) for c in confs) + " |")
+    return "\n".join(lines)
+
+
+def _intro(summary: dict, scale: str) -> list[str]:
+    st = summary["settings"]
+    rule = "free cells only" if st["zero_obstacles"] else "every cell, obstacles included"
+    return [
+        f"Made at scale `{scale}`. Oracle heatmaps are built from the labels, not a network "
+        "(`vnrrt.evaluation.oracles`): each idea is a family of oracles over its targets, "
+        "blurs (Gaussian sigma) and heatmap-draw probabilities, and the path-vertex blend H_w "
+        "spans the space between the two ideas. Each family's best member (its envelope) is "
+        f"chosen on {summary['selection']['instances']} selection instances of "
+        f"{len(summary['selection']['maps'])} base maps ({st['selection_share']:.0%} of the maps) "
+        f"and reported on {summary['instances']} evaluation instances of "
+        f"{len(summary['maps'])} other base maps. Speed-ups are paired against RRT* in the same "
+        "cell and under the same obstacle rule: geometric mean of median(RRT*) / "
+        f"median(planner), {level_name(st['level'])} CI from {st['bootstrap']:,} bootstrap "
+        "resamples over base maps. 'Mass near target' is the share of the heatmap's mass "
+        f"within {st['radius']:g} px of its target. The obstacle rule, one for every heatmap "
+        f"source and for the uniform part of every sampler: {rule} (the default; "
+        "`eval.zero_obstacles`: the paper's uniform sampling covers the whole map and its "
+        "networks' heatmaps are used as predicted); the other rule is measured once, in the "
+        "protocol's cell. Back to [the paper comparison](paper_comparison.md).",
+    ]
+
+
+def build_ideas_report(summary: dict, scale: str, figures: list[str]) -> str:
+    """The whole ``sampling_ideas.md``; ``figures``: the figure files to show, relative to
+    the report."""
+    eps = summary["settings"]["eps"]
+    parts = [
+        "# What each sampling idea can give",
+        "",
+        *_intro(summary, scale),
+        "",
+        "## Conclusion",
+        "",
+        *[f"- {line}" for line in conclusion(summary)],
+        "",
+    ]
+    for stop in ("initial", *OPTIMAL_STOPS):
+        if stop not in summary["selection"]["speedups"]:
+            continue
+        parts += [
+            f"## Envelopes, {stop_name(stop, eps)}",
+            "",
+            "Selection:",
+            "",
+            selection_table(summary, stop),
+            "",
+            "Evaluation (fewer iterations than RRT*, "
+            "and the vertex and blend envelopes against the path envelope):",
+            "",
+            envelope_table(summary, stop),
+            "",
+            "The blend at each w against w = 0:",
+            "",
+            blend_table(summary, stop),
+            "",
+        ]
+    parts += [
+        "## The heatmap-quality curve",
+        "",
+        "Each path and vertex envelope diluted "
+        "towards a uniform map (signal fraction q), in the protocol's cell; every stop rule's "
+        "envelopes are run under each stop rule, * marks the stop rule's own (the figure shows "
+        "only those, and the conclusion reads only those).",
+        "",
+    ]
+    for stop in OPTIMAL_STOPS:
+        parts += [f"### {stop_name(stop, eps)}", "", quality_table(summary, stop), ""]
+    parts += [f"![quality curve]({f})" for f in figures if "quality" in f] + [""]
+    parts += ["## The obstacle rule", "", rule_table(summary, "optimal"), ""]
+    parts += [
+        "## The planner regime",
+        "",
+        "Time speed-up over RRT* in the same cell (Steer "
+        f"step eta, near-radius rule, goal radius), to within {percent(eps)} of the reference.",
+    ]
+    for stop in OPTIMAL_STOPS:
+        parts += ["", f"### {stop_name(stop, eps)}", "", regime_section(summary, stop)]
+        parts += ["", budget_table(summary, stop)]
+    parts += [""] + [f"![regime]({f})" for f in figures if "regime" in f] + [""]
+    return "\n".join(parts) + "\n"
