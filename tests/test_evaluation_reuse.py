@@ -84,6 +84,14 @@ def test_a_tau_ablation_reruns_only_m_vnrrt_and_renumbers_the_rest(instances, tm
     assert grown[list(SEEDED_COLUMNS)].equals(fresh[list(SEEDED_COLUMNS)])
 
 
+def test_planner_tau_and_taus_rerun_no_configuration_naming_its_tau(instances, tmp_path, calls):
+    run(instances, [RRT, NRRT, mvn(0.5)], tmp_path / "store")
+    calls.clear()
+    ablation = CONFIG.replace(tau=0.7, taus=[0.3, 0.7])
+    run(instances, [RRT, NRRT, mvn(0.5)], tmp_path / "store", config=ablation)
+    assert calls == []  # M-VNRRT*'s key names its own tau: the config's is not read
+
+
 def test_a_setting_every_configuration_uses_reruns_them_all(instances, tmp_path, calls):
     run(instances, [RRT, NRRT], tmp_path / "store")
     calls.clear()

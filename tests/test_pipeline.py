@@ -523,6 +523,9 @@ def test_a_tau_ablation_reruns_only_m_vnrrt_and_moves_no_other_verdict(workdir):
     row comes back byte for byte, timings included (the trial stages log what they reused),
     and no claim without M-VNRRT* changes its verdict."""
     run(["dvc", "repro"], workdir)
+    run(["git", "add", "-A"], workdir)  # dvc exp run needs a commit to start from
+    run(["git", "-c", "user.name=t", "-c", "user.email=t@t", "commit", "--allow-empty", "-qm",
+         "before the tau ablation"], workdir)  # fmt: skip
     before, verdicts = _rows_by_trial(workdir), _verdicts(workdir)
     ablation = ("planner.eps=0.05", "stats.level=0.9", "planner.taus=[0.3,0.5,0.7]",
                 "planner.tau=0.7")  # fmt: skip

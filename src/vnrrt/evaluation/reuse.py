@@ -6,7 +6,8 @@ A *configuration* here is one (configuration key, regime cell) of a stage's jobs
 digest is the sha256 of, per job in order: the instance (every field of
 :class:`~vnrrt.data.instances.EvalInstance`, with the one heatmap the key samples), the
 job's key, stop rule, trial range and regime cell, the planner settings the job runs with
-(:func:`job_config`: the cell's settings with the key's informed flag and tau), the heatmap
+(:func:`run_settings`: the cell's settings with the key's informed flag and tau, less what
+its run does not read), the heatmap
 settings (:class:`~vnrrt.evaluation.trials.HeatSettings`), the global seed (the trials'
 seeds derive from it and the instance index), and the source of the code that plans and
 measures (:func:`code_digest`). A configuration with the same digest ran the same trials, so
@@ -104,6 +105,19 @@ def job_config(job: TrialJob, configs: dict):
     return config
 
 
+def run_settings(job: TrialJob, configs: dict) -> dict:
+    """The planner settings that decide job ``job``'s trials: :func:`job_config`'s fields
+    without ``taus`` (the thresholds a study evaluates, read by no planner run) and, for a key
+    without a threshold, without ``tau`` (read by M-VNRRT* only), so that a tau ablation
+    leaves the other configurations' rows valid."""
+    config = job_config(job, configs)
+    out = {f.name: getattr(config, f.name) for f in dataclasses.fields(config)}
+    out.pop("taus", None)
+    if job.key.tau is None:
+        out.pop("tau", None)
+    return out
+
+
 def group_digests(items: list, configs: dict, heat, seed: int, code: str) -> dict:
     """``{(key text, regime): (digest, [item index, ...])}`` of ``items`` (``(job, instance)``
     pairs, the instance holding only the heatmap the job samples), in first-seen order."""
@@ -116,7 +130,7 @@ def group_digests(items: list, configs: dict, heat, seed: int, code: str) -> dic
         for i in idx:
             job, inst = items[i]
             fields = (job.instance, job.key.text, job.stop, job.first, job.count, job.regime)
-            h.update(digest(fields, job_config(job, configs), inst).encode())
+            h.update(digest(fields, run_settings(job, configs), inst).encode())
         out[group] = (h.hexdigest(), idx)
     return out
 
