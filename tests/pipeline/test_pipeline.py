@@ -385,7 +385,7 @@ def stages_writing_their_outputs(workdir: Path) -> set[str]:
         seen.add(stage)
         outs = [str(p) for p in stage_outputs(stage, paths, item)]
         for path in entry["written"]:
-            if path.startswith(NOT_OUTPUTS):
+            if path.startswith((*NOT_OUTPUTS, paths.reuse + "/")):  # the kept rows: a cache
                 continue
             assert any(path == o or path.startswith(o + "/") for o in outs), (stage, item, path)
         for out in outs:  # every declared output exists (an unchanged one is not rewritten)
@@ -524,6 +524,57 @@ def test_an_ablation_would_rerun_only_the_evaluation(workdir):
         params.write_text(session)
     ran = sorted(line.split("'")[1] for line in out.splitlines() if "Running stage" in line)
     assert ran == EVALUATION_STAGES, out
+
+
+def _rows_by_trial(workdir: Path) -> dict[tuple, str]:
+    """Every trial row of the workspace's parts as its CSV text without ``seq``, keyed by
+    (key, instance, stop, trial)."""
+    rows = {}
+    for part in sorted((workdir / "data/smoke/trials").glob("part_*.csv")):
+        header, *lines = part.read_text().splitlines()
+        cols = header.split(",")
+        for line in lines:
+            values = dict(zip(cols, line.split(","), strict=True))
+            who = (values["key"], values["instance"], values["stop"], values["trial"])
+            rows[who] = line.split(",", 1)[1]  # seq is the first column
+    return rows
+
+
+def _verdicts(workdir: Path) -> dict[str, str]:
+    summary = json.loads((workdir / "data/smoke/summary.json").read_text())
+    return {f"{r['planner']} vs {r['baseline']} {r['column']}": r["verdict"]
+            for r in summary["claims"]["rows"]}  # fmt: skip
+
+
+@pytest.mark.slow
+def test_a_tau_ablation_reruns_only_m_vnrrt_and_moves_no_other_verdict(workdir):
+    """`dvc exp run -S planner.tau=0.7` (the session's other values kept; its taus with 0.5,
+    the session's planner.tau, so that the same M-VNRRT* thresholds run) re-runs only the
+    M-VNRRT* configurations at planner.tau (its masked variants and control): every other
+    row comes back byte for byte, timings included (the trial stages log what they reused),
+    and no claim without M-VNRRT* changes its verdict."""
+    run(["dvc", "repro"], workdir)
+    run(["git", "add", "-A"], workdir)  # dvc exp run needs a commit to start from
+    run(["git", "-c", "user.name=t", "-c", "user.email=t@t", "commit", "--allow-empty", "-qm",
+         "before the tau ablation"], workdir)  # fmt: skip
+    before, verdicts = _rows_by_trial(workdir), _verdicts(workdir)
+    ablation = ("planner.eps=0.05", "stats.level=0.9", "planner.taus=[0.3,0.5,0.7]",
+                "planner.tau=0.7")  # fmt: skip
+    sets = [x for o in ("scale=smoke", seed_override(workdir), *ablation) for x in ("-S", o)]
+    out = run(["dvc", "exp", "run", *sets], workdir)
+    assert "reused" in out
+    after = _rows_by_trial(workdir)
+    moved = {k for k in before.keys() & after.keys() if before[k] != after[k]}
+    assert moved == set() and {k[0] for k in after.keys() - before.keys()} <= {
+        k for k, *_ in after if k.startswith("m_vnrrt_star")
+    }
+    assert {k for k, *_ in after if not k.startswith("m_vnrrt_star")} == {
+        k for k, *_ in before if not k.startswith("m_vnrrt_star")
+    }
+    now = _verdicts(workdir)
+    for claim, verdict in verdicts.items():
+        if "m_vnrrt_star" not in claim:
+            assert now[claim] == verdict, claim
 
 
 ABLATION = {  # every reader-visible setting changed at once from the session's (one experiment)

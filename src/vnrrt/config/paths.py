@@ -33,6 +33,7 @@ class Paths:
     timing: str
     trials: str
     trials_table: str
+    reuse: str
     summary: str
     oracle: str
     regime: str
@@ -71,6 +72,11 @@ class Paths:
     def shard(self, shard_id: int) -> Path:
         """Shard ``shard_id`` (stage ``shard@<id>``)."""
         return shard_file(self.shards, shard_id)
+
+    def reuse_store(self, stage: str) -> Path:
+        """The kept trial rows of stage ``stage``'s configurations (a cache, not an output:
+        :mod:`vnrrt.evaluation.reuse`)."""
+        return Path(self.reuse) / stage
 
     def checkpoint(self, network: str) -> Path:
         """The trained network's checkpoint (stage ``train@<network>``)."""

@@ -14,22 +14,26 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import logging
 import math
 import time
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
 from vnrrt.data.heatmaps import HeatmapError
 from vnrrt.data.instances import EvalInstance
-from vnrrt.evaluation import sources
+from vnrrt.evaluation import reuse, sources
 from vnrrt.evaluation.keys import ConfigKey
 from vnrrt.evaluation.protocol import TrialJob, trial_jobs, trial_seed
 from vnrrt.evaluation.sampling import build_sampler, free_rule
-from vnrrt.evaluation.table import CONVERGENCE_FACTORS, TrialRow, frame
+from vnrrt.evaluation.table import CONVERGENCE_FACTORS, TrialRow, conform, frame
 from vnrrt.infra.parallel import parallel_map
 from vnrrt.planners import PlannerConfig, plan, warmup
+
+log = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True)
@@ -91,11 +95,7 @@ def run_job(
     """The rows of one job on its instance (``args``: the job and its instance);
     ``configs`` holds the planner settings of each regime cell (``''``: the protocol's)."""
     job, inst = args
-    key, stop, config = job.key, job.stop, configs[job.regime]
-    if key.informed:
-        config = config.replace(informed=True)
-    if key.tau is not None:
-        config = config.replace(tau=key.tau)
+    key, stop, config = job.key, job.stop, reuse.job_config(job, configs)
     warmup()
     free = free_rule(key, heat.zero_obstacles)
     allowed = sources.allowed_cells(inst.grid, free)
@@ -160,15 +160,36 @@ def run_jobs(
     workers: int,
     config: PlannerConfig | dict[str, PlannerConfig],
     heat: HeatSettings,
+    store: str | Path | None = None,
 ) -> pd.DataFrame:
     """The rows of ``jobs`` (on ``instances[job.instance]``) as a trial table in ``seq``
     order. ``config``: the planner settings, or one per regime cell (label -> settings). A
-    trial that exhausts a budget is a row with ``success=False``."""
+    trial that exhausts a budget is a row with ``success=False``. With a ``store`` folder,
+    a configuration whose inputs, settings and code are unchanged reuses its kept rows
+    (:mod:`vnrrt.evaluation.reuse`) and the others' rows are kept there."""
     configs = config if isinstance(config, dict) else {"": config}
     fn = functools.partial(run_job, seed=seed, configs=configs, heat=heat)
     items = [_needed(job, instances[job.instance]) for job in jobs]
-    rows = parallel_map(fn, items, workers, "trials")
-    return frame([r for rs in rows for r in rs])
+    if store is None:
+        rows = parallel_map(fn, items, workers, "trials")
+        return frame([r for rs in rows for r in rs])
+    groups = reuse.group_digests(items, configs, heat, seed, reuse.code_digest())
+    tables, todo = [], []
+    for key, idx in groups.values():
+        table = reuse.load(store, key, [items[i][0] for i in idx])
+        if table is None:
+            todo.append((key, idx))
+        else:
+            tables.append(table)
+    log.info(reuse.summary(len(tables), len(groups)))
+    order = sorted(i for _, idx in todo for i in idx)  # the protocol's interleaved order
+    done = parallel_map(fn, [items[i] for i in order], workers, "trials")
+    rows = dict(zip(order, done, strict=True))
+    for key, idx in todo:  # each configuration kept as soon as the pool is done
+        tables.append(frame([r for i in idx for r in rows[i]]))
+        reuse.keep(store, key, tables[-1])
+    merged = pd.concat(tables, ignore_index=True) if tables else frame([])
+    return conform(merged.sort_values("seq", kind="stable", ignore_index=True), "trial rows")
 
 
 def run_trials(

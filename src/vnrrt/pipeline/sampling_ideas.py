@@ -138,8 +138,9 @@ def _study(s: dict) -> Study:
     return Study(s["paths"], s["eval"], s["oracle"], s["regime"], s["seed"], s["protocol"])
 
 
-def _run(s: dict, jobs: list, configs: dict, out: Path, networks: list[str]) -> int:
-    """Run ``jobs`` (their instances read with the ``networks``' heatmaps) -> ``out``."""
+def _run(s: dict, jobs: list, configs: dict, out: Path, networks: list[str], stage: str) -> int:
+    """Run ``jobs`` (their instances read with the ``networks``' heatmaps) -> ``out``, reusing
+    the kept rows of stage ``stage``'s unchanged configurations."""
     from vnrrt.data.instances import load
     from vnrrt.evaluation.table import write_table
     from vnrrt.evaluation.trials import HeatSettings, run_jobs
@@ -150,7 +151,8 @@ def _run(s: dict, jobs: list, configs: dict, out: Path, networks: list[str]) -> 
     instances, targets = load(st.paths.instances, indices, networks, st.paths.heatmaps, parts)
     oc, ev = st.oracle, st.ev
     heat = HeatSettings(oc.radius, ev.endpoint_radius, targets, None, oc.floor, ev.zero_obstacles)
-    table = run_jobs(jobs, instances, s["seed"], s["workers"], configs, heat)
+    store = st.paths.reuse_store(stage)
+    table = run_jobs(jobs, instances, s["seed"], s["workers"], configs, heat, store)
     write_table(table, out)
     return len(table)
 
@@ -169,7 +171,7 @@ def run_oracle_part(cfg: DictConfig, part: int) -> int:
     st = _study(s)
     jobs = _part(st.selection_jobs(), part, st.oracle.parts, "oracle")
     log.info("selection part %d/%d: %d jobs", part, len(st.oracle.parts), len(jobs))
-    return _run(s, jobs, {"": s["planner"]}, st.paths.oracle_part(part), [])
+    return _run(s, jobs, {"": s["planner"]}, st.paths.oracle_part(part), [], "oracle")
 
 
 def run_regime_part(cfg: DictConfig, part: int) -> int:
@@ -185,7 +187,8 @@ def run_regime_part(cfg: DictConfig, part: int) -> int:
     cells = {label: planner.replace(**o) for label, o in overrides.items()}
     networks = sorted({j.key.source for j in jobs if j.key.source and not is_oracle(j.key.source)})
     log.info("evaluation part %d/%d: %d jobs", part, len(st.regime.parts), len(jobs))
-    return _run(s, jobs, {PROTOCOL: planner, **cells}, st.paths.regime_part(part), networks)
+    configs = {PROTOCOL: planner, **cells}
+    return _run(s, jobs, configs, st.paths.regime_part(part), networks, "regime")
 
 
 def ideas_tables(settings: dict) -> dict:

@@ -119,7 +119,8 @@ def run_budget_trials(cfg: DictConfig, steps: int) -> int:
     log.info("budget %d: %d trial jobs on %d instances", steps, len(jobs), len(instances))
     heat = HeatSettings(s["oracle"]["radius"], design.endpoint_radius, targets,
                         zero_obstacles=design.zero_obstacles)  # fmt: skip
-    table = run_jobs(jobs, instances, s["seed"], s["workers"], planner, heat)
+    store = paths.reuse_store("budget_trials")
+    table = run_jobs(jobs, instances, s["seed"], s["workers"], planner, heat, store)
     write_table(table, paths.budget_trials(steps))
     return len(table)
 
