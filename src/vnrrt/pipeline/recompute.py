@@ -22,7 +22,7 @@ import shutil
 import sys
 from pathlib import Path
 
-from vnrrt.config import ConfigError, load_params, restrict, stage_params
+from vnrrt.config import ConfigError, compose, load_params, restrict, stage_params
 
 BUNDLE = {  # file -> what it holds
     "params.yaml": "the run's parameters (the composed config)",
@@ -114,6 +114,9 @@ def recompute(bundle: Path, out: Path) -> list[Path]:
     if missing:
         raise ConfigError(f"results bundle {bundle} lacks {missing} (see its README.md)")
     cfg = load_params(bundle / "params.yaml")
+    # every input comes from the bundle but the paper's numbers and settings, read where this
+    # repository keeps them: the paths of this code, not of the run that made the bundle
+    cfg.paths = compose([f"scale={cfg.scale.name}"]).paths
     predict, trainings = read_json(bundle / "predict.json"), read_json(bundle / "train.json")
     out.mkdir(parents=True, exist_ok=True)
     summary = evaluate_summary(read_table(bundle / "trials.csv.gz"),
