@@ -9,6 +9,8 @@ from pathlib import Path
 
 import numpy as np
 
+from vnrrt.io import load_npy
+
 
 class UsageError(ValueError):
     """A command-line argument is wrong; the message names it."""
@@ -91,7 +93,7 @@ def load_instance(path: Path, instance: str | None) -> dict:
     if instance is not None:
         raise UsageError(f"--instance needs a shard or named-maps .npz, not {path.suffix}")
     if path.suffix == ".npy":
-        return {"grid": np.load(path)}
+        return {"grid": load_npy(path, "map file", UsageError)}
     if path.suffix == ".png":
         from vnrrt.maps.image import read_map_image
 
@@ -114,7 +116,7 @@ def load_heatmap(
     if not path.is_file():
         raise UsageError(f"heatmap file {path} not found")
     if path.suffix == ".npy":
-        return np.load(path).astype(np.float64)
+        return load_npy(path, "heatmap file", UsageError).astype(np.float64)
     if path.suffix == ".png":
         return _read_image(path)
     if path.suffix == ".npz":
