@@ -1,5 +1,6 @@
 """DVC stage budget_report@training_budget: the budget curve's statistics, report, figures."""
 
+import _interpreter  # noqa: F401  (the venv's python: stages/_interpreter.py)
 from vnrrt.evaluation.training_budget.stage import run_budget_report
 from vnrrt.stage_cli import stage_main
 

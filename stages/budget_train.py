@@ -1,5 +1,6 @@
 """DVC stage budget_train@<network>-<steps>: one network of the training-budget curve."""
 
+import _interpreter  # noqa: F401  (the venv's python: stages/_interpreter.py)
 from vnrrt.stage_cli import stage_main
 from vnrrt.training.stage import run_budget_train
 

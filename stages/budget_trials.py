@@ -1,5 +1,6 @@
 """DVC stage budget_trials@<steps>: planner trials on one budget's heatmaps."""
 
+import _interpreter  # noqa: F401  (the venv's python: stages/_interpreter.py)
 from vnrrt.evaluation.training_budget.stage import run_budget_trials
 from vnrrt.stage_cli import stage_main
 

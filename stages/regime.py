@@ -1,5 +1,6 @@
 """DVC stage regime@<k>: part k of the planner-regime sweep."""
 
+import _interpreter  # noqa: F401  (the venv's python: stages/_interpreter.py)
 from vnrrt.evaluation.sampling_ideas.stage import run_regime_part
 from vnrrt.stage_cli import stage_main
 

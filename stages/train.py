@@ -1,5 +1,6 @@
 """DVC stage train@<network>: train VertexNet or the NRRT* network."""
 
+import _interpreter  # noqa: F401  (the venv's python: stages/_interpreter.py)
 from vnrrt.stage_cli import stage_main
 from vnrrt.training.stage import run_train
 

@@ -1,5 +1,6 @@
 """DVC stage trials@<k>: part k of the evaluation protocol's planner trials."""
 
+import _interpreter  # noqa: F401  (the venv's python: stages/_interpreter.py)
 from vnrrt.evaluation.stage import run_trials_part
 from vnrrt.stage_cli import stage_main
 

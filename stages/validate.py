@@ -1,5 +1,6 @@
 """DVC stage validate: check the whole composed configuration before any work."""
 
+import _interpreter  # noqa: F401  (the venv's python: stages/_interpreter.py)
 from vnrrt.stage_cli import stage_main
 from vnrrt.validate import run_validate
 
