@@ -96,7 +96,7 @@ CASES = {  # rule fragment -> the planted values of row ROW
         "cost": math.inf,
         "success": False,
         "stop_reason": "max_iterations",
-    },  # fmt: skip
+    },
     "t_1.05x is NaN or in 0..time_to_stop": {"t_1.05x": -1.0},
 }
 
