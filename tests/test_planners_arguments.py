@@ -43,9 +43,26 @@ def test_a_reachable_reference_still_plans(call):
 
 
 def test_the_check_alone():
-    check_stop_target("optimal", STRAIGHT * (1 - 1e-12), START, GOAL)  # rounding: accepted
+    exact = PlannerConfig(eps=0.0)
+    check_stop_target("optimal", STRAIGHT * (1 - 1e-12), START, GOAL, exact)  # rounding
     check_stop_target("initial", 0.0, START, GOAL)  # only recorded under 'initial'
     check_stop_target("optimal", None, START, GOAL)  # None: the reference is computed
     check_stop_target("optimal", 20, "not a point", GOAL)  # left to the endpoints' checks
+    check_stop_target("optimal", 1.0, START, GOAL, "not a config")  # left to its own check
     with pytest.raises(ValueError, match="below the straight-line distance"):
-        check_stop_target("optimal", 12.9, START, GOAL)
+        check_stop_target("optimal", 12.9, START, GOAL, exact)
+    # within eps below the straight line: (1 + eps) x reference reaches it, so it is accepted
+    check_stop_target("optimal", STRAIGHT / 1.01, START, GOAL)  # the default eps, 0.01
+    with pytest.raises(ValueError, match="below the straight-line distance"):
+        check_stop_target("optimal", STRAIGHT / 1.011, START, GOAL)
+    with pytest.raises(ValueError, match="below the straight-line distance"):
+        check_stop_target("optimal", STRAIGHT / 1.01, START, GOAL, exact)
+
+
+def test_a_reference_within_eps_below_the_straight_line_is_met_by_it():
+    cfg = PlannerConfig(straight_first=True)
+    ref = STRAIGHT / (1 + cfg.eps)  # (1 + eps) x ref: the straight line's length
+    a = plan(GRID, START, GOAL, stop="optimal", reference_length=ref, seed=1, config=cfg)
+    b = Planner(GRID, config=cfg).solve(START, GOAL, stop="optimal", reference_length=ref)
+    for r in (a, b):
+        assert r.success and r.cost == pytest.approx(STRAIGHT)

@@ -7,17 +7,21 @@ from __future__ import annotations
 import math
 import numbers
 
-# A reference this much (relative) below the straight-line distance is rounding, not a
+from vnrrt.planners.config import PlannerConfig
+
+# A stop bound this much (relative) below the straight-line distance is rounding, not a
 # mistake: an exact optimum that is the straight segment, summed from its turning points.
 STRAIGHT_TOLERANCE = 1e-9
 
 
-def check_stop_target(stop, reference_length, start, goal) -> None:
+def check_stop_target(stop, reference_length, start, goal, config=None) -> None:
     """Raise unless ``reference_length`` is None or a real number (``TypeError``) and, for
-    ``stop='optimal'``, a positive finite length (pixels) at least the straight-line distance
-    from ``start`` to ``goal`` (continuous ``(x, y)`` pixels; ``ValueError``): the cost of
-    any path is at least that distance, so a smaller reference could never be met. Points
-    that are not two numbers each are left to the endpoints' own checks."""
+    ``stop='optimal'``, a positive finite length (pixels) whose stop bound ``(1 + eps) x
+    reference_length`` (``config.eps``; None: :class:`PlannerConfig`'s) is at least the
+    straight-line distance from ``start`` to ``goal`` (continuous ``(x, y)`` pixels;
+    ``ValueError``): the cost of any path is at least that distance, so a lower bound could
+    never be met. Points that are not two numbers each, and a ``config`` that is not a
+    :class:`PlannerConfig`, are left to their own checks."""
     if reference_length is None:
         return
     if isinstance(reference_length, bool) or not isinstance(reference_length, numbers.Real):
@@ -36,9 +40,13 @@ def check_stop_target(stop, reference_length, start, goal) -> None:
         (sx, sy), (gx, gy) = ((float(v) for v in p) for p in (start, goal))
     except (TypeError, ValueError):
         return
-    straight = math.hypot(gx - sx, gy - sy)
-    if ref < straight * (1.0 - STRAIGHT_TOLERANCE):
+    eps = PlannerConfig.eps if config is None else getattr(config, "eps", None)
+    if not isinstance(config, PlannerConfig | None) or not isinstance(eps, numbers.Real):
+        return
+    straight, bound = math.hypot(gx - sx, gy - sy), (1.0 + float(eps)) * ref
+    if bound < straight * (1.0 - STRAIGHT_TOLERANCE):
         raise ValueError(
-            f"reference_length {ref!r} is below the straight-line distance {straight!r} from "
-            f"start to goal: no path can meet stop='optimal'"
+            f"reference_length {ref!r}: its stop bound (1 + eps) x {ref!r} = {bound!r} is below "
+            f"the straight-line distance {straight!r} from start to goal: no path can meet "
+            "stop='optimal'"
         )
