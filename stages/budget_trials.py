@@ -1,5 +1,6 @@
 """DVC stage budget_trials@<steps>: planner trials on one budget's heatmaps."""
 
+import _interpreter  # noqa: F401  (the venv's python: stages/_interpreter.py)
 from vnrrt.cli.stage import stage_main
 from vnrrt.pipeline.training_budget import run_budget_trials
 

@@ -1,5 +1,6 @@
 """DVC stage oracle@<k>: part k of the oracle study (oracle heatmaps, quality curve)."""
 
+import _interpreter  # noqa: F401  (the venv's python: stages/_interpreter.py)
 from vnrrt.cli.stage import stage_main
 from vnrrt.pipeline.sampling_ideas import run_oracle_part
 

@@ -1,5 +1,6 @@
 """DVC stage trials@<k>: part k of the evaluation protocol's planner trials."""
 
+import _interpreter  # noqa: F401  (the venv's python: stages/_interpreter.py)
 from vnrrt.cli.stage import stage_main
 from vnrrt.pipeline.evaluation import run_trials_part
 

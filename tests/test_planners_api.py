@@ -147,8 +147,9 @@ def test_budgets_are_failures_not_exceptions(grid):
     r = plan(grid, START, GOAL, stop="initial", config=PlannerConfig(max_iterations=30))
     assert not r.success and r.stop_reason == "max_iterations" and r.iterations == 30
     assert r.path.shape == (0, 2) and math.isinf(r.cost) and math.isnan(r.time_to_first)
-    r = plan(grid, START, GOAL, stop="optimal", reference_length=1.0,
-             config=PlannerConfig(max_seconds=0.05))  # fmt: skip
+    # the straight-line length at eps 0: a target no tree path (with a turn) meets
+    r = plan(grid, START, GOAL, stop="optimal", reference_length=math.dist(START, GOAL),
+             config=PlannerConfig(max_seconds=0.05, eps=0.0))  # fmt: skip
     assert not r.success and r.stop_reason == "max_seconds" and r.path.shape[1] == 2
 
 
@@ -269,10 +270,11 @@ def test_min_spacing_stops_nodes_piling_up_under_a_concentrated_heatmap(grid, sp
     hot = np.zeros(grid.shape)
     hx, hy = 20, 20
     hot[hy, hx] = 1.0
-    # reference 1 px: never reached, so the run takes all 4,000 iterations
-    cfg = PlannerConfig(tau=0.5, min_spacing=spacing, max_iterations=4000)
+    # the straight-line length at eps 0: never reached, so the run takes all 4,000 iterations
+    cfg = PlannerConfig(tau=0.5, min_spacing=spacing, max_iterations=4000, eps=0.0)
     r = plan(grid, (5.5, 5.5), (54.5, 54.5), "m_vnrrt_star", heatmap=hot, config=cfg,
-             stop="optimal", reference_length=1.0, seed=3, keep_tree=True)  # fmt: skip
+             stop="optimal", reference_length=math.dist((5.5, 5.5), (54.5, 54.5)), seed=3,
+             keep_tree=True)  # fmt: skip
     pts = r.tree_points
     inside = (np.floor(pts[:, 0]) == hx) & (np.floor(pts[:, 1]) == hy)
     if spacing > 0:
@@ -361,9 +363,8 @@ def answers(request, monkeypatch) -> types.SimpleNamespace:
         ("initial", None, np.int64(8), {}, True),
         ("initial", None, (8, 1), {}, True),
         ("initial", None, (8, -1), {}, False),  # refused by the general path (a ValueError)
-        ("optimal", 5.0, 9, {}, False),  # the segment (5.39 px) above the bound: a search
     ],
-)  # (the last: the common form, checked in C when its answer is in use: _common, not _query)
+)  # (a reference below the segment's length is an error now: tests/test_planners_arguments.py)
 def test_a_free_segments_one_pass_answer_is_the_general_paths(
     grid, heat, monkeypatch, answers, stop, reference, seed, extra, fast
 ):
@@ -464,8 +465,9 @@ def test_one_shot_plans_reuse_a_pooled_tree_and_give_the_same_results(grid, monk
             a.cost, a.iterations, a.tree_size, a.collision_checks)  # fmt: skip
         np.testing.assert_array_equal(r.path, a.path)
     run.POOL.clear()
-    big = PlannerConfig(max_iterations=20_000)
-    r = plan(grid, START, GOAL, stop="optimal", reference_length=1.0, seed=0, config=big)
+    big = PlannerConfig(max_iterations=20_000, eps=0.0)  # the straight line: never met
+    r = plan(grid, START, GOAL, stop="optimal", reference_length=math.dist(START, GOAL), seed=0,
+             config=big)  # fmt: skip
     assert r.tree_size > run.FIRST_CAPACITY  # it grew, so it was not given back
     assert run.POOL.take((run.FIRST_CAPACITY, grid.shape, 5.0, big.trace_capacity)) is None
 

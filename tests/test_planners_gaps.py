@@ -118,14 +118,14 @@ def test_a_gap_sampler_that_starts_after_the_run_changes_nothing():
                 seed=3)  # fmt: skip
     assert_same_run(base, late)
     k = base.iterations // 2
-    cut = NO_GAPS.replace(max_iterations=k)
-    a = plan(g, s, e, config=cut, stop="optimal", reference_length=1.0, seed=3)
+    cut = NO_GAPS.replace(max_iterations=k, eps=0.0)  # the straight line at eps 0: never met
+    a = plan(g, s, e, config=cut, stop="optimal", reference_length=math.dist(s, e), seed=3)
     b = plan(g, s, e, config=cut.replace(gap_share=0.5, gap_after=k), stop="optimal",
-             reference_length=1.0, seed=3)  # fmt: skip
+             reference_length=math.dist(s, e), seed=3)  # fmt: skip
     assert a.iterations == b.iterations == k and a.stop_reason == "max_iterations"
     assert_same_run(a, b)
-    c = plan(g, s, e, config=NO_GAPS.replace(max_iterations=k + 200, gap_share=0.5,
-             gap_after=k), stop="optimal", reference_length=1.0, seed=3)  # fmt: skip
+    c = plan(g, s, e, config=cut.replace(max_iterations=k + 200, gap_share=0.5,
+             gap_after=k), stop="optimal", reference_length=math.dist(s, e), seed=3)  # fmt: skip
     assert c.tree_size != a.tree_size or c.collision_checks != a.collision_checks  # it drew
 
 

@@ -167,8 +167,8 @@ def test_uninformed_runs_add_nodes_that_cannot_improve_the_first_solution():
     fm = named_map("u_trap", 200)
     s, g = fm.starts[0] + 0.5, fm.goals[0] + 0.5
     first = plan(fm.grid, s, g, stop="initial", keep_tree=True, seed=2)
-    r = plan(fm.grid, s, g, stop="optimal", reference_length=1.0, keep_tree=True, seed=2,
-             config=PlannerConfig(max_iterations=4000))  # fmt: skip
+    r = plan(fm.grid, s, g, stop="optimal", reference_length=math.dist(s, g), keep_tree=True,
+             seed=2, config=PlannerConfig(max_iterations=4000, eps=0.0))  # fmt: skip
     np.testing.assert_array_equal(r.tree_points[: first.tree_size], first.tree_points)
     later = r.tree_points[first.tree_size :]
     f_hat = costs_to_come(r.tree_points, r.tree_parents)[first.tree_size :]
@@ -203,12 +203,9 @@ def test_the_straight_segment_first_is_the_optimum_at_once():
     tree = plan(grid, s, g, config=first, keep_tree=True)
     np.testing.assert_allclose(tree.tree_points, [s, g])
     assert list(tree.tree_parents) == [-1, 0]
-    # a stop bound below the straight segment cannot be met: the search runs to its budget
-    short = plan(grid, s, g, stop="optimal", reference_length=10.0, seed=0,
-                 config=first.replace(max_iterations=300))  # fmt: skip
-    assert not short.success and short.stop_reason == "max_iterations"
-    assert short.time_to_first < short.time_to_stop
-    assert short.cost == pytest.approx(math.dist(s, g))
+    # a stop bound below the straight segment cannot be met: an error naming the argument
+    with pytest.raises(ValueError, match="reference_length 10.0: .* below the straight-line"):
+        plan(grid, s, g, stop="optimal", reference_length=10.0, seed=0, config=first)
     blocked = grid.copy()
     blocked[40:60, 40:60] = 1
     r2 = plan(blocked, s, g, stop="initial", config=first, seed=0)
@@ -218,12 +215,15 @@ def test_the_straight_segment_first_is_the_optimum_at_once():
 @pytest.mark.parametrize("straight_first", [False, True])
 @pytest.mark.parametrize("budget", [1, 2, 5, 40])
 def test_an_unreachable_bound_runs_exactly_the_iteration_budget(budget, straight_first):
-    """With the goal joined at once (straight segment, any-distance goal radius) and nearly
-    every iteration adding a node (an empty map), the tree has room for the whole budget."""
+    """With the goal joined as soon as it is seen (any-distance goal radius) and nearly every
+    iteration adding a node (a map empty but for a block on the straight segment, whose
+    length at eps 0 is the bound: never met), the tree has room for the whole budget."""
     grid = np.zeros((100, 100), np.uint8)
+    grid[44:52, 46:54] = 1  # around the segment's midpoint (50, 48)
+    s, g = (3.5, 4.5), (96.5, 91.5)
     cfg = PlannerConfig(goal_radius=math.inf, straight_first=straight_first,
-                        max_iterations=budget)  # fmt: skip
-    r = plan(grid, (3.5, 4.5), (96.5, 91.5), stop="optimal", reference_length=1.0, config=cfg)
+                        max_iterations=budget, eps=0.0)  # fmt: skip
+    r = plan(grid, s, g, stop="optimal", reference_length=math.dist(s, g), config=cfg)
     assert r.stop_reason == "max_iterations" and r.iterations == budget
 
 
@@ -243,8 +243,8 @@ def test_tree_memory_follows_the_work_done_not_the_budget(monkeypatch):
     assert r.success and sizes == [FIRST_CAPACITY] and r.tree_size < FIRST_CAPACITY
     sizes.clear()
     run.POOL.clear()
-    r = plan(fm.grid, s, g, stop="optimal", reference_length=1.0,
-             config=PlannerConfig(max_iterations=10_000))  # fmt: skip
+    r = plan(fm.grid, s, g, stop="optimal", reference_length=math.dist(s, g),
+             config=PlannerConfig(max_iterations=10_000, eps=0.0))  # fmt: skip
     assert r.stop_reason == "max_iterations" and r.iterations == 10_000
     assert sizes[0] == FIRST_CAPACITY and len(sizes) > 1
     assert all(b == min(2 * a, 10_002) for a, b in itertools.pairwise(sizes))

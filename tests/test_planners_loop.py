@@ -29,13 +29,13 @@ CASES = [
     ("rrt_star", FASTEST, "optimal", (1.2, 1.05)),
     ("vnrrt_star", PlannerConfig(informed=True), "optimal", (1.5,)),
     ("m_vnrrt_star", PlannerConfig(tau=0.5), "initial", ()),
-    ("rrt_star", PlannerConfig(max_iterations=9000), "unreachable", ()),  # the tree fills up
+    ("rrt_star", PlannerConfig(max_iterations=9000, eps=0.0), "unreachable", ()),  # fills up
     ("rrt_star", FASTEST.replace(gap_share=0.3, gap_after=100), "optimal", (1.1,)),  # gaps
     ("vnrrt_star", PlannerConfig(gap_share=0.2, gap_width=4), "initial", ()),
     # gaps and a tree that fills up: the compiled loop finds the cells again after enlarging
     (
         "rrt_star",
-        PlannerConfig(max_iterations=9000, gap_share=0.3, gap_after=100),
+        PlannerConfig(max_iterations=9000, gap_share=0.3, gap_after=100, eps=0.0),
         "unreachable",
         (),
     ),
@@ -53,7 +53,8 @@ def test_the_compiled_loop_grows_the_same_tree_as_the_python_loop(
     fm = named_map("cluttered", 200)
     s, g = fm.starts[0] + 0.5, fm.goals[0] + 0.5
     heat = None if planner == "rrt_star" else np.asarray(fm.grid == 0, float)
-    ref = 1.0 if stop == "unreachable" else None  # a target no run meets: the budget ends it
+    # the straight line at eps 0 (a turning map): a target no run meets, the budget ends it
+    ref = math.dist(s, g) if stop == "unreachable" else None
     stop = "optimal" if stop == "unreachable" else stop
     results = {}
     for compiled in (True, False):
@@ -80,7 +81,7 @@ def test_the_compiled_loop_stops_at_the_time_budget():
     """max_seconds ends a run that cannot meet its target, soon after the budget."""
     fm = named_map("cluttered", 200)
     s, g = fm.starts[0] + 0.5, fm.goals[0] + 0.5
-    cfg = PlannerConfig(max_seconds=0.05, max_iterations=10**9)
-    r = plan(fm.grid, s, g, config=cfg, stop="optimal", reference_length=1.0, seed=0)
+    cfg = PlannerConfig(max_seconds=0.05, max_iterations=10**9, eps=0.0)  # the straight line
+    r = plan(fm.grid, s, g, config=cfg, stop="optimal", reference_length=math.dist(s, g), seed=0)
     assert r.stop_reason == "max_seconds" and not r.success
     assert 0.05 <= r.time_to_stop < 1.0

@@ -262,12 +262,13 @@ def test_an_unlimited_step_and_a_small_gamma_change_the_tree(turning):
                       gamma_factors=[1.0, 0.01], goal_radii=[None])  # fmt: skip
     cells = regime_cells(rc, ELSEWHERE)
     assert "eta=inf radius=fixed1 goal=eta" not in cells and len(cells) == 5
-    base = PlannerConfig(max_iterations=3000)
+    base = PlannerConfig(max_iterations=3000, eps=0.0)  # target: the straight line, never met
+    unmet = math.dist(turning.start, turning.goal)
     trees = {}
     for label in ("eta=inf radius=shrinking goal=eta", "eta=10 radius=shrinking goal=eta",
                   "eta=10 radius=shrinking*0.01 goal=eta"):  # fmt: skip
         r = plan(turning.grid, turning.start, turning.goal, config=base.replace(**cells[label]),
-                 keep_tree=True, seed=2, stop="optimal", reference_length=1e-9)  # fmt: skip
+                 keep_tree=True, seed=2, stop="optimal", reference_length=unmet)  # fmt: skip
         pts, par = r.tree_points, r.tree_parents
         child = np.flatnonzero(par >= 0)
         trees[label] = np.hypot(*(pts[child] - pts[par[child]]).T)
@@ -302,13 +303,14 @@ def test_the_cell_with_the_protocols_own_settings_is_left_out(turning):
     through plan()); it is left out of the grid and of the evaluation, and only it."""
     rc = RegimeConfig(etas=[10.0, 20.0], radius_modes=["shrinking", "fixed1"],
                       gamma_factors=[1.0, 0.5], goal_radii=[None, math.inf])  # fmt: skip
-    base = PlannerConfig(max_iterations=2000)
+    base = PlannerConfig(max_iterations=2000, eps=0.0)  # target: the straight line, never met
     every, cells = regime_cells(rc, ELSEWHERE), regime_cells(rc, protocol_settings(base))
     twin = "eta=10 radius=shrinking goal=eta"
     assert set(every) - set(cells) == {twin} and len(cells) == len(every) - 1 == 11
     assert base.replace(**every[twin]) == base
     runs = [plan(turning.grid, turning.start, turning.goal, config=c, seed=3, stop="optimal",
-                 reference_length=1e-9) for c in (base, base.replace(**every[twin]))]  # fmt: skip
+                 reference_length=math.dist(turning.start, turning.goal))
+            for c in (base, base.replace(**every[twin]))]  # fmt: skip
     assert runs[0].iterations == runs[1].iterations and runs[0].cost == runs[1].cost
     ev = Configurations(sources={"vnrrt_star": "vertexnet"}, informed=False)
     env = {"optimal": {"path": "nrrt_star~0.5[oracle_path@s2]"}}

@@ -219,9 +219,12 @@ def test_an_unreachable_tracking_server_fails_at_once_before_any_work(small_data
 class Health(http.server.BaseHTTPRequestHandler):
     status = 200
 
-    def do_GET(self):
-        self.send_response(self.status if self.path == "/health" else 404)
+    def do_GET(self):  # /health and MLflow's REST API (an empty JSON object), else 404
+        known = self.path == "/health" or self.path.startswith("/api/2.0/mlflow/")
+        self.send_response(self.status if known else 404)
         self.end_headers()
+        if known and self.status == 200:
+            self.wfile.write(b"{}")
 
     def log_message(self, *args):
         pass

@@ -9,6 +9,8 @@ from pathlib import Path
 
 import numpy as np
 
+from vnrrt.infra.io import load_npy
+
 
 class UsageError(ValueError):
     """A command-line argument is wrong; the message names it."""
@@ -57,6 +59,30 @@ def _verify_against_manifest(path: Path) -> None:
             raise UsageError(f"{path} is not listed in {manifest}")
 
 
+# The first bytes of each kind of file the commands write (``--out``).
+MAGIC = {".png": b"\x89PNG\r\n\x1a\n", ".npy": b"\x93NUMPY"}
+
+
+def check_out(path: Path, suffixes: tuple[str, ...]) -> None:
+    """Refuse an ``--out`` that the command would not write as asked: a name not ending in
+    one of ``suffixes`` (the kinds it writes, keys of :data:`MAGIC`), a directory, a folder
+    that does not exist, or an existing file of another kind (its first bytes are not
+    those of its suffix's format): such a file is the user's, never overwritten."""
+    kinds = " or ".join(suffixes)
+    if path.is_dir():
+        raise UsageError(f"--out {path} is a directory; give a {kinds} file name")
+    if path.suffix.lower() not in suffixes:
+        raise UsageError(f"--out {path}: give a {kinds} file name (it writes {kinds} only)")
+    if not path.parent.is_dir():
+        raise UsageError(f"--out {path}: directory {path.parent} does not exist (create it)")
+    if path.exists():
+        magic = MAGIC[path.suffix.lower()]
+        with open(path, "rb") as f:
+            if f.read(len(magic)) != magic:
+                raise UsageError(f"--out {path} exists and is not a {path.suffix} file; "
+                                 "not overwriting it (move it or choose another name)")  # fmt: skip
+
+
 def load_instance(path: Path, instance: str | None) -> dict:
     """Grid ``(H, W)`` uint8 and, where the file holds them, start/goal points and the A*
     length (formats in the module doc)."""
@@ -67,7 +93,7 @@ def load_instance(path: Path, instance: str | None) -> dict:
     if instance is not None:
         raise UsageError(f"--instance needs a shard or named-maps .npz, not {path.suffix}")
     if path.suffix == ".npy":
-        return {"grid": np.load(path)}
+        return {"grid": load_npy(path, "map file", UsageError)}
     if path.suffix == ".map":  # MovingAI (vnrrt.maps.movingai): the grid only
         from vnrrt.maps.movingai import read_map
 

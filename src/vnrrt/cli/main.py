@@ -35,7 +35,13 @@ from pathlib import Path
 import numpy as np
 
 from vnrrt import __version__
-from vnrrt.cli.inputs import UsageError, check_planner_target, load_heatmap, load_instance
+from vnrrt.cli.inputs import (
+    UsageError,
+    check_out,
+    check_planner_target,
+    load_heatmap,
+    load_instance,
+)
 from vnrrt.cli.scen import add_scen_arguments, run_scen
 from vnrrt.cli.stage import EXIT_BUDGET, EXIT_HELP, EXIT_OK, run_reporting
 
@@ -179,8 +185,8 @@ def run_plan(args: argparse.Namespace) -> int:
     if heatmap is None and args.planner != "rrt_star":
         raise UsageError(f"--planner {args.planner} samples a heatmap: give --heatmap FILE "
                          "or --checkpoint CKPT (e.g. models/quick/vertexnet.ckpt)")  # fmt: skip
-    if args.out is not None and args.out.is_dir():
-        raise UsageError(f"--out {args.out} is a directory; give a .png file name")
+    if args.out is not None:
+        check_out(args.out, (".png",))
     result = plan(inst["grid"], start, goal, args.planner, heatmap=heatmap,
                   stop=args.stop, reference_length=_reference(inst, start, goal, cfg),
                   seed=args.seed, config=cfg if args.tau is None else cfg.replace(tau=args.tau),
@@ -224,14 +230,13 @@ def run_predict(args: argparse.Namespace) -> int:
 
     inst = load_instance(args.map, args.instance)
     start, goal = _endpoints(args, inst)
-    if args.out.suffix not in (".npy", ".png") or args.out.is_dir():
-        raise UsageError(f"--out {args.out}: give a .npy or .png file name")
+    check_out(args.out, (".npy", ".png"))
     cells = point_to_cell(np.array([start, goal]))
     heat = heatmap(args.checkpoint, inst["grid"], tuple(cells[0]), tuple(cells[1]), args.device,
                    pad=args.pad)  # fmt: skip
     from vnrrt.infra.io import atomic_write_bytes
 
-    if args.out.suffix == ".npy":
+    if args.out.suffix.lower() == ".npy":
         atomic_write_bytes(args.out, lambda f: np.save(f, heat))
     else:
         import cv2

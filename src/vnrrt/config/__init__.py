@@ -158,7 +158,22 @@ def load_params(path: str | Path = "params.yaml") -> DictConfig:
         raise ConfigError(f"parameters file {path} is not valid YAML: {err}") from None
     if not isinstance(cfg, DictConfig) or not cfg:
         raise ConfigError(f"parameters file {path} is empty or not a mapping (run `make params`)")
+    missing = [k for k in sections_of_composition() if k not in cfg]
+    if missing:
+        raise ConfigError(f"parameters file {path} lacks the sections {missing}: cut short or "
+                          "not a composition of conf/ (run `make params`)")  # fmt: skip
     return cfg
+
+
+def sections_of_composition() -> list[str]:
+    """The top-level keys every composition of ``conf/config.yaml`` has: its own keys and one
+    section per config group of its defaults list (``hydra`` aside)."""
+    import yaml
+
+    root = yaml.safe_load((CONF_DIR / "config.yaml").read_text())
+    groups = [next(iter(d)) for d in root.get("defaults", []) if isinstance(d, dict)]
+    own = [k for k in root if k != "defaults"]
+    return [k for k in dict.fromkeys(own + groups) if k != "hydra"]
 
 
 # Sections every stage receives without listing them as DVC params: where files go
@@ -190,12 +205,12 @@ def stage_params(stage: str, dvc_yaml: str | Path = "dvc.yaml") -> list[str]:
     in a key becomes ``item``; of a ``matrix`` stage ``name@a-b``, ``${item.<k>}`` becomes
     the value of its k-th matrix key) in ``dvc_yaml``; :class:`ConfigError` if it is not
     there."""
-    import yaml
+    from vnrrt.infra.io import read_yaml
 
     path = Path(dvc_yaml)
     if not path.is_file():
         raise ConfigError(f"{path} not found: run stages from the repository root")
-    stages = (yaml.safe_load(path.read_text()) or {}).get("stages", {})
+    stages = (read_yaml(path, "pipeline file", ConfigError) or {}).get("stages", {})
     name, _, item = stage.partition("@")
     if name not in stages:
         raise ConfigError(f"stage {name!r} is not in {path}")
@@ -232,16 +247,18 @@ def check_unchanged_since_validate(params: str | Path, dvc_lock: str | Path) -> 
     stages would use the second run's values (issue #28). :class:`ConfigError` names every
     changed key with both values. Nothing is checked when the lock or its ``validate``
     entry is absent (a first run, a stage script run by hand)."""
-    import yaml
+    from vnrrt.infra.io import read_yaml
 
     lock = Path(dvc_lock)
     if not lock.is_file():
         return
-    entry = ((yaml.safe_load(lock.read_text()) or {}).get("stages") or {}).get("validate")
+    entry = ((read_yaml(lock, "DVC lock file", ConfigError) or {}).get("stages") or {}).get(
+        "validate"
+    )
     recorded = ((entry or {}).get("params") or {}).get(Path(params).name)
     if not recorded:
         return
-    now = yaml.safe_load(Path(params).read_text()) or {}
+    now = read_yaml(params, "parameters file", ConfigError) or {}
     before = _leaves(recorded)
     after = _leaves({k: now.get(k) for k in recorded})
     changed = [

@@ -26,13 +26,12 @@ from __future__ import annotations
 
 import io
 import json
-import zipfile
 from pathlib import Path
 
 import numpy as np
 
 from vnrrt.config.paths import heatmaps_part_file as part_file
-from vnrrt.infra.io import atomic_write_bytes
+from vnrrt.infra.io import atomic_write_bytes, load_npz
 
 FORMAT_VERSION = 2
 PREFIX = "net_"  # field name prefix of a network's heatmaps
@@ -76,11 +75,7 @@ def read_heatmaps(path: str | Path) -> dict:
         raise HeatmapError(
             f"heatmap file {path} does not exist (run the predict stages: `dvc repro`)"
         )
-    try:
-        with np.load(path, allow_pickle=False) as npz:
-            arrays = {k: npz[k] for k in npz.files}
-    except (OSError, ValueError, zipfile.BadZipFile, EOFError) as err:  # missing, cut, foreign
-        raise HeatmapError(f"heatmap file {path} is not a readable .npz: {err}") from None
+    arrays = load_npz(path, "heatmap file", HeatmapError)  # cut, damaged, foreign
     missing = [k for k in ("format_version", "meta", "keys") if k not in arrays]
     if missing or int(arrays["format_version"]) != FORMAT_VERSION:
         raise HeatmapError(f"heatmap file {path}: missing {missing} or not format {FORMAT_VERSION}")

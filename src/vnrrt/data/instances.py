@@ -43,12 +43,12 @@ from __future__ import annotations
 import dataclasses
 import functools
 import json
-import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
+from vnrrt.infra.io import load_npz
 from vnrrt.search.astar import moves_to_path
 
 FORMAT_VERSION = 1
@@ -105,11 +105,7 @@ class EvalInstance:
 
 @functools.lru_cache(maxsize=4)
 def _load(path: str, mtime: float) -> dict[str, np.ndarray]:
-    try:
-        with np.load(path, allow_pickle=False) as npz:
-            arrays = {k: npz[k] for k in npz.files}
-    except (OSError, ValueError, EOFError, zipfile.BadZipFile) as err:
-        raise InstancesError(f"instances file {path} is unreadable: {err}") from None
+    arrays = load_npz(path, "instances file", InstancesError)
     if int(arrays.get("format_version", -1)) != FORMAT_VERSION:
         raise InstancesError(f"instances file {path} is not format {FORMAT_VERSION}")
     return arrays

@@ -7,7 +7,6 @@ pipeline wrote (:func:`verify_manifest`); ``data.json`` holds the figures DVC re
 
 from __future__ import annotations
 
-import json
 import os
 from pathlib import Path
 
@@ -15,7 +14,7 @@ import numpy as np
 
 from vnrrt.data.reader import TEST, TRAIN, Shard
 from vnrrt.data.shards import FORMAT_VERSION, ShardError, shard_file
-from vnrrt.infra.io import sha256, write_json
+from vnrrt.infra.io import read_json, sha256, write_json
 
 
 def shard_entry(path: Path) -> dict:
@@ -75,13 +74,18 @@ def verify_manifest(manifest: str | Path) -> list[Path]:
     manifest = Path(manifest)
     if not manifest.is_file():
         raise ShardError(f"manifest {manifest} does not exist (run `dvc repro`)")
-    doc = json.loads(manifest.read_text())
+    try:
+        doc = read_json(manifest)
+        entries = [(e["file"], e["sha256"]) for e in doc["shards"]]
+    except (ValueError, KeyError, TypeError) as err:  # not JSON, or entries without fields
+        why = f"no field {err}" if isinstance(err, KeyError) else str(err).splitlines()[0]
+        raise ShardError(f"manifest {manifest} is not a shard manifest: {why}") from None
     paths = []
-    for entry in doc["shards"]:
-        path = manifest.parent / entry["file"]
+    for file, digest in entries:
+        path = manifest.parent / file
         if not path.is_file():
             raise ShardError(f"shard {path} listed in {manifest} is missing")
-        if sha256(path) != entry["sha256"]:
+        if sha256(path) != digest:
             raise ShardError(f"shard {path} does not match its checksum in {manifest}")
         paths.append(path)
     return paths

@@ -36,7 +36,7 @@ from pathlib import Path
 import numpy as np
 
 from vnrrt.config.paths import shard_file  # noqa: F401  (re-exported)
-from vnrrt.infra.io import atomic_write_bytes
+from vnrrt.infra.io import atomic_write_bytes, load_npz
 
 FORMAT_VERSION = 1
 FIELDS = {
@@ -84,11 +84,7 @@ def read_arrays(path: str | Path) -> dict[str, np.ndarray]:
     path = Path(path)
     if not path.is_file():
         raise ShardError(f"shard file {path} does not exist")
-    try:
-        with np.load(path, allow_pickle=False) as npz:
-            arrays = {k: npz[k] for k in npz.files}
-    except (OSError, ValueError, zipfile.BadZipFile, EOFError) as err:
-        raise ShardError(f"shard file {path} is unreadable or corrupt: {err}") from None
+    arrays = load_npz(path, "shard file", ShardError)
     version = arrays.get("format_version")
     if version is None or int(version) != FORMAT_VERSION:
         raise ShardError(

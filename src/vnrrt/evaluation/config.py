@@ -91,15 +91,20 @@ class EvalConfig(Configurations):
 @dataclass
 @conf_defaults("planner")
 class Rules:
-    """``planner.eps``, ``planner.taus`` and ``planner.tau``: the stop tolerance and the
-    M-VNRRT* thresholds, for the stages that name them without planning."""
+    """``planner.eps``, ``planner.taus``, ``planner.tau`` and ``planner.max_iterations``:
+    the stop tolerance, the M-VNRRT* thresholds and the iteration budget, for the stages that
+    name them without planning (the budget bounds a trial table's ``iterations``:
+    :mod:`vnrrt.evaluation.invariants`)."""
 
     eps: float
     taus: list[float]
     tau: float
+    max_iterations: int  # the budget bounds a trial table's iterations
 
     def validate(self) -> None:
         check(self.eps >= 0, "planner.eps", self.eps, "must be >= 0")
+        check(self.max_iterations > 0, "planner.max_iterations", self.max_iterations,
+              "must be > 0")  # fmt: skip
         ok = all(0 < t <= 1 for t in [*self.taus, self.tau])
         check(ok, "planner.taus", [*self.taus, self.tau], "every tau must be in (0, 1]")
 

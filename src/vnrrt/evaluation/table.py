@@ -17,7 +17,7 @@ import numpy as np
 import pandas as pd
 
 from vnrrt.config.paths import table_part_file as part_file
-from vnrrt.infra.io import write_text
+from vnrrt.infra.io import DECODE_ERRORS, write_text
 
 # Cost bounds (x reference length) whose first-reach time is recorded in optimal runs: the
 # convergence curve (cost versus time) of every trial.
@@ -127,21 +127,29 @@ def read_table(path: str | Path) -> pd.DataFrame:
     floats = {c: ["nan"] for c, d in DTYPES.items() if d == "float64"}
     try:
         table = pd.read_csv(path, dtype=dtypes, keep_default_na=False, na_values=floats)
-    except (ValueError, pd.errors.ParserError) as err:
-        raise TableError(f"trial table {path} is unreadable: {err}") from None
+    except (*DECODE_ERRORS, pd.errors.ParserError) as err:  # cut, damaged, not a table
+        why = " ".join(str(err).split()) or type(err).__name__
+        raise TableError(f"trial table {path} is unreadable: {why}") from None
     for col in ("success", "fallback_uniform"):
         if col in table and table[col].dtype != bool:
             table[col] = table[col].astype(str).str.lower() == "true"
     return conform(table, str(path))
 
 
-def merge_parts(directory: str | Path, parts: list[int], expected: int) -> pd.DataFrame:
+def merge_parts(
+    directory: str | Path, parts: list[int], expected: int, design=None
+) -> pd.DataFrame:
     """The tables of ``parts`` merged in ``seq`` order. :class:`TableError` naming the missing
-    files, or the directory unless the rows are exactly ``seq`` 0 .. expected-1."""
+    files, or the directory unless the rows are exactly ``seq`` 0 .. expected-1, or a part
+    and its row that breaks a rule of ``design`` (a
+    :class:`vnrrt.evaluation.invariants.Design`; None: unchecked)."""
     missing = [str(part_file(directory, k)) for k in parts if not part_file(directory, k).is_file()]
     if missing:
         raise TableError(f"trial tables {missing} do not exist (run `dvc repro`)")
     tables = [read_table(part_file(directory, k)) for k in parts]
+    if design is not None:
+        for k, table in zip(parts, tables, strict=True):
+            design.check(table, str(part_file(directory, k)))
     table = pd.concat(tables, ignore_index=True).sort_values("seq", kind="stable")
     if not np.array_equal(table["seq"].to_numpy(), np.arange(expected)):
         raise TableError(

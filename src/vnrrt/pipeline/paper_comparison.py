@@ -17,10 +17,9 @@ import dataclasses
 import logging
 from pathlib import Path
 
-import yaml
 from omegaconf import DictConfig, OmegaConf
 
-from vnrrt.config import sections
+from vnrrt.config import ConfigError, sections
 from vnrrt.config.paths import Paths
 
 log = logging.getLogger(__name__)
@@ -30,12 +29,14 @@ def evaluate_settings(cfg: DictConfig) -> dict:
     """What stage ``evaluate`` reads, typed (keyed by config section)."""
     from vnrrt.evaluation.config import EvalConfig, Rules, StatsConfig
 
-    return sections(cfg, paths=Paths, eval=EvalConfig, stats=StatsConfig, planner=Rules)
+    typed = sections(cfg, paths=Paths, eval=EvalConfig, stats=StatsConfig, planner=Rules)
+    return typed | {"seed": int(cfg.seed)}
 
 
 def run_evaluate(cfg: DictConfig) -> dict:
     """Stage ``evaluate`` (module doc); returns the summary."""
     from vnrrt.data.instances import Instances
+    from vnrrt.evaluation.invariants import design_of
     from vnrrt.evaluation.protocol import configurations, trial_counts, trial_jobs
     from vnrrt.evaluation.table import merge_parts, write_table
     from vnrrt.infra.io import read_json, write_json, write_text
@@ -44,8 +45,10 @@ def run_evaluate(cfg: DictConfig) -> dict:
     s = evaluate_settings(cfg)
     paths, ev, rules = s["paths"], s["eval"], s["planner"]
     keys = configurations(ev, rules.mask_taus, rules.tau)
-    jobs = trial_jobs(Instances(paths.instances).kinds, keys, trial_counts(ev))
-    table = merge_parts(paths.trials, ev.parts, sum(j.count for j in jobs))
+    inst = Instances(paths.instances)
+    jobs = trial_jobs(inst.kinds, keys, trial_counts(ev))
+    design = design_of(inst, rules.eps, rules.max_iterations, s["seed"], keys)
+    table = merge_parts(paths.trials, ev.parts, sum(j.count for j in jobs), design)
     write_table(table, paths.trials_table)
     summary = evaluate_summary(table, s, read_json(paths.predict_metrics))
     write_json(paths.summary, summary)
@@ -95,7 +98,9 @@ def report_settings(cfg: DictConfig) -> dict:
 
     typed = sections(cfg, paths=Paths, eval=EvalConfig, planner=PlannerConfig)
     typed |= sections(cfg, logger=LoggerConfig) | {"scale": {"name": str(cfg.scale.name)}}
-    settings = yaml.safe_load(Path(typed["paths"].paper_settings).read_text())
+    from vnrrt.infra.io import read_yaml
+
+    settings = read_yaml(typed["paths"].paper_settings, "the paper's settings table", ConfigError)
     keys = [e["key"] for e in settings["settings"] if e.get("key")]
     values = {k: OmegaConf.to_container(v) if OmegaConf.is_config(v := OmegaConf.select(cfg, k))
               else v for k in keys}  # fmt: skip

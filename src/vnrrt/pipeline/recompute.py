@@ -99,7 +99,6 @@ def _schema() -> str:
 def recompute(bundle: Path, out: Path) -> list[Path]:
     """Recompute the statistics and reports from the bundle alone (module doc) into
     ``out``; returns the files written."""
-    from vnrrt.evaluation.table import read_table
     from vnrrt.infra.io import read_json, write_json, write_text
     from vnrrt.pipeline.paper_comparison import (
         evaluate_settings,
@@ -118,9 +117,10 @@ def recompute(bundle: Path, out: Path) -> list[Path]:
     # repository keeps them: the paths of this code, not of the run that made the bundle
     cfg.paths = compose([f"scale={cfg.scale.name}"]).paths
     predict, trainings = read_json(bundle / "predict.json"), read_json(bundle / "train.json")
+    es = evaluate_settings(_view(cfg, "evaluate"))
+    tables = checked_tables(bundle, es, read_json(bundle / "instances.json")["optima"])
     out.mkdir(parents=True, exist_ok=True)
-    summary = evaluate_summary(read_table(bundle / "trials.csv.gz"),
-                               evaluate_settings(_view(cfg, "evaluate")), predict)  # fmt: skip
+    summary = evaluate_summary(tables["trials"], es, predict)
     write_json(out / "summary.json", summary)
     summary = read_json(out / "summary.json")  # as the report stage reads it
     rs = report_settings(_view(cfg, "report"))
@@ -128,11 +128,34 @@ def recompute(bundle: Path, out: Path) -> list[Path]:
     write_text(out / "paper_comparison.md", report_text(rs, summary, predict, trainings, optima))
     write_json(out / "headline.json", headline(summary, predict["networks"]))
     ids = ideas_settings(_view(cfg, "ideas"))
-    tables = {w: read_table(bundle / f"{w}.csv.gz") for w in ("oracle", "regime")}
-    write_json(out / "ideas.json", ideas_summary(tables, ids))
+    write_json(out / "ideas.json", ideas_summary({w: tables[w] for w in ("oracle", "regime")}, ids))
     write_text(out / "sampling_ideas.md", ideas_text(read_json(out / "ideas.json"), ids))
     names = ("summary.json", "paper_comparison.md", "headline.json", "ideas.json")
     return [out / n for n in (*names, "sampling_ideas.md")]
+
+
+def checked_tables(bundle: Path, es: dict, optima: dict) -> dict:
+    """The bundle's three trial tables (``{"trials", "oracle", "regime"}``), each checked
+    against what physics and the protocol guarantee (:mod:`vnrrt.evaluation.invariants`,
+    with stage ``evaluate``'s settings ``es`` and the instances' mean ``optima``); the paper
+    comparison's keys must be its configurations."""
+    import dataclasses
+
+    from vnrrt.evaluation.invariants import bundle_design
+    from vnrrt.evaluation.protocol import configurations
+    from vnrrt.evaluation.table import read_table
+
+    files = {w: bundle / f"{w}.csv.gz" for w in ("trials", "oracle", "regime")}
+    tables = {w: read_table(f) for w, f in files.items()}
+    rules = es["planner"]
+    design = bundle_design({str(f): tables[w] for w, f in files.items()}, optima, rules.eps,
+                           rules.max_iterations, es["seed"])  # fmt: skip
+    keys = frozenset(k.text for k in configurations(es["eval"], rules.mask_taus, rules.tau))
+    for w, f in files.items():
+        (dataclasses.replace(design, keys=keys) if w == "trials" else design).check(
+            tables[w], str(f)
+        )
+    return tables
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -53,6 +53,15 @@ class Study:
     regime: RegimeConfig | None
     seed: int
     protocol: dict
+    rules: Rules | None = None  # eps and max_iterations: the merged tables' checks
+
+    def design(self):
+        """What the merged tables' rows must keep (:mod:`vnrrt.evaluation.invariants`)."""
+        from vnrrt.data.instances import Instances
+        from vnrrt.evaluation.invariants import design_of
+
+        inst = Instances(self.paths.instances)
+        return design_of(inst, self.rules.eps, self.rules.max_iterations, self.seed)
 
     def instances(self) -> tuple[list[str], list[int], list[int]]:
         """``(kinds, selection, evaluation)``: the instance kinds and the split (design)."""
@@ -83,7 +92,7 @@ class Study:
         from vnrrt.studies.sampling_ideas.selection import member_speedups, select
 
         rows = sum(j.count for j in self.selection_jobs())
-        table = merge_parts(self.paths.oracle, self.oracle.parts, rows)
+        table = merge_parts(self.paths.oracle, self.oracle.parts, rows, self.design())
         speedups = member_speedups(table, family_members(self.oracle))
         return speedups, select(speedups)
 
@@ -135,7 +144,8 @@ def ideas_settings(cfg: DictConfig) -> dict:
 
 def _study(s: dict) -> Study:
     """The :class:`Study` of a stage's settings (:func:`part_settings`, :func:`ideas_settings`)."""
-    return Study(s["paths"], s["eval"], s["oracle"], s["regime"], s["seed"], s["protocol"])
+    return Study(s["paths"], s["eval"], s["oracle"], s["regime"], s["seed"], s["protocol"],
+                 s["planner"])  # fmt: skip
 
 
 def _run(s: dict, jobs: list, configs: dict, out: Path, networks: list[str], stage: str) -> int:
@@ -199,9 +209,11 @@ def ideas_tables(settings: dict) -> dict:
     st = _study(settings)
     _, envelopes = st.envelopes()
     rows = sum(j.count for j in st.selection_jobs())
-    oracle = merge_parts(st.paths.oracle, st.oracle.parts, rows)
+    design = st.design()
+    oracle = merge_parts(st.paths.oracle, st.oracle.parts, rows, design)
     rows = sum(j.count for j in st.evaluation_jobs(envelopes))
-    return {"oracle": oracle, "regime": merge_parts(st.paths.regime, st.regime.parts, rows)}
+    regime = merge_parts(st.paths.regime, st.regime.parts, rows, design)
+    return {"oracle": oracle, "regime": regime}
 
 
 def ideas_summary(tables: dict, settings: dict) -> dict:

@@ -135,6 +135,7 @@ def report_settings(cfg: DictConfig) -> dict:
         "eval": _design(cfg),
         "scale": {"name": str(cfg.scale.name)},
         "train": {"seed": int(cfg.train.seed)},
+        "seed": int(cfg.seed),
     }
 
 
@@ -143,19 +144,23 @@ def budget_inputs(s: dict) -> list[dict]:
     "trainings": {network: training metrics}}``; :class:`~vnrrt.evaluation.table.TableError`
     unless each trial table holds exactly its jobs' rows."""
     from vnrrt.data.instances import Instances
+    from vnrrt.evaluation.invariants import design_of
     from vnrrt.evaluation.table import TableError, read_table
     from vnrrt.infra.io import read_json
     from vnrrt.studies.training_budget.design import BudgetTrials
 
-    paths, design, tau = s["paths"], BudgetTrials(**s["eval"]), s["planner"].tau
-    rows = sum(j.count for j in design.jobs(Instances(paths.instances).kinds, tau))
-    networks = sorted({k.source for k in design.keys(tau) if k.source is not None})
+    paths, design, rules = s["paths"], BudgetTrials(**s["eval"]), s["planner"]
+    inst = Instances(paths.instances)
+    rows = sum(j.count for j in design.jobs(inst.kinds, rules.tau))
+    expected = design_of(inst, rules.eps, rules.max_iterations, s["seed"], design.keys(rules.tau))
+    networks = sorted({k.source for k in design.keys(rules.tau) if k.source is not None})
     out = []
     for steps in s["budget"].steps:
         table = read_table(paths.budget_trials(steps))
         if len(table) != rows:
             raise TableError(f"{paths.budget_trials(steps)} holds {len(table)} trials, not the "
                              f"{rows} of this protocol (re-run `dvc repro`)")  # fmt: skip
+        expected.check(table, str(paths.budget_trials(steps)))
         trainings = {n: read_json(paths.budget_training(n, steps).metrics) for n in networks}
         predict = read_json(paths.budget_predict_metrics(steps))
         out.append({"steps": steps, "trials": table, "predict": predict, "trainings": trainings})
@@ -180,11 +185,10 @@ def run_budget_report(cfg: DictConfig, name: str) -> dict:
 
 def summary_settings(s: dict) -> dict:
     """What the summary records of the run (its readers take every value from there)."""
-    import yaml
-
+    from vnrrt.infra.io import read_yaml
     from vnrrt.studies.training_budget.design import BudgetTrials
 
-    paper = yaml.safe_load(Path(s["paths"].paper_settings).read_text())
+    paper = read_yaml(s["paths"].paper_settings, "the paper's settings table", ConfigError)
     design, rules, st = BudgetTrials(**s["eval"]), s["planner"], s["stats"]
     return {
         "scale": s["scale"]["name"],

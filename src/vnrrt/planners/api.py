@@ -26,6 +26,7 @@ import numpy as np
 
 from vnrrt.grid import GridError, as_occupancy, as_point
 from vnrrt.planners import core, run, settings
+from vnrrt.planners.arguments import check_stop_target
 from vnrrt.planners.collision import segment_free
 from vnrrt.planners.config import PLANNERS, PlannerConfig
 from vnrrt.planners.native import answerer, planned, solved
@@ -373,8 +374,11 @@ class Planner:
         Raises:
             GridError: bad start or goal.
             NoPathError: the A* reference is needed and start and goal are not connected.
-            ValueError: unknown stop rule, bad reference length or seed.
+            ValueError: unknown stop rule, bad reference length or seed (a reference
+                length that no path can meet: :func:`.arguments.check_stop_target`).
+            TypeError: a reference length that is not a number.
         """
+        check_stop_target(stop, reference_length, start, goal, self.config)
         ask = (stop, reference_length, seed, milestones, keep_tree)
         answer = solved(self, start, goal, *ask)  # the common form answered in C, else None
         if answer is not None:
@@ -437,6 +441,7 @@ def plan(
     that form's segment does not answer, the tree's run is made without a :class:`Planner`
     too (:func:`_one_shot`: the settings kept per config and map shape, the tree's arrays
     from a pool; the same result as a Planner's, ``setup_time`` 0: no sampler is built)."""
+    check_stop_target(stop, reference_length, start, goal, config)
     answer = planned(grid, start, goal, planner, heatmap, config, sampler, stop,
                      reference_length, seed, milestones, keep_tree)  # fmt: skip
     if answer is not None and type(answer) is not tuple:  # the common form, answered in C

@@ -5,9 +5,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import yaml
-
 from vnrrt.config import ConfigError
+from vnrrt.infra.io import read_yaml
 
 
 def load_paper_tables(path: str | Path) -> dict:
@@ -15,8 +14,7 @@ def load_paper_tables(path: str | Path) -> dict:
     path = Path(path)
     if not path.is_file():
         raise ConfigError(f"the paper's tables {path} do not exist")
-    with open(path) as f:
-        paper = yaml.safe_load(f)
+    paper = read_yaml(path, "the paper's tables", ConfigError)
     if not isinstance(paper, dict) or not {"columns", "tables", "claims"} <= set(paper):
         raise ConfigError(f"the paper's tables {path} lack columns, tables or claims")
     return paper

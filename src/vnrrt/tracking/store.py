@@ -37,6 +37,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import json
 import os
 import socket
 import sqlite3
@@ -103,23 +104,17 @@ def artifact_root(uri: str, configured: str | None = None) -> str:
 @functools.lru_cache(maxsize=16)
 def check_store(uri: str, timeout: float = CHECK_SECONDS) -> None:
     """Raise :class:`TrackingError` within about ``timeout`` seconds when the tracking server
-    (``http(s)://``: its ``/health`` page) or database server (``postgresql://`` etc.: its
-    port) of ``uri`` does not answer. Local stores (SQLite, files) need no check. A store
-    that answered is not checked again in this process."""
+    (``http(s)://``) does not answer or is not MLflow's (:func:`_check_server`), the
+    database server (``postgresql://`` etc.: its port) of ``uri`` does not answer, or a local
+    SQLite store is not an intact database (:func:`_check_sqlite`). A store that passed is
+    not checked again in this process."""
     parts = urlsplit(uri)
     scheme = parts.scheme.split("+")[0]
     fix = "start it, or set logger.uri / MLFLOW_TRACKING_URI to a reachable store"
     if scheme in ("http", "https"):
-        try:
-            urllib.request.urlopen(f"{uri.rstrip('/')}/health", timeout=timeout).close()
-        except urllib.error.HTTPError as err:  # it answered: reachable, unless it failed
-            if err.code >= 500:
-                raise TrackingError(
-                    f"tracking server {uri} answers HTTP {err.code}: {fix}"
-                ) from None
-        except (OSError, ValueError) as err:  # URLError, timeouts, refused connections
-            why = getattr(err, "reason", err)
-            raise TrackingError(f"tracking server {uri} does not answer ({why}): {fix}") from None
+        _check_server(uri, timeout, fix)
+    elif scheme == "sqlite" and uri.startswith("sqlite:///"):
+        _check_sqlite(Path(uri[len("sqlite:///") :]))
     elif scheme in DB_PORTS and parts.hostname:
         address = (parts.hostname, parts.port or DB_PORTS[scheme])
         try:
@@ -127,6 +122,63 @@ def check_store(uri: str, timeout: float = CHECK_SECONDS) -> None:
         except OSError as err:
             raise TrackingError(f"tracking database {parts.hostname}:{address[1]} of {scheme} "
                                 f"store does not answer ({err}): {fix}") from None  # fmt: skip
+
+
+# An MLflow REST call every tracking server answers with a JSON object (its experiments).
+MLFLOW_PROBE = "/api/2.0/mlflow/experiments/search?max_results=1"
+
+
+def _check_server(uri: str, timeout: float, fix: str) -> None:
+    """Raise :class:`TrackingError` unless the server at ``uri`` answers MLflow's REST API
+    (:data:`MLFLOW_PROBE`) with JSON; one asking for credentials (HTTP 401, 403) passes: MLflow
+    sends them (``MLFLOW_TRACKING_USERNAME``, a token)."""
+    try:
+        with urllib.request.urlopen(uri.rstrip("/") + MLFLOW_PROBE, timeout=timeout) as answer:
+            body = answer.read(1 << 20)
+    except urllib.error.HTTPError as err:  # it answered
+        if err.code in (401, 403):
+            return
+        if err.code >= 500:
+            raise TrackingError(f"tracking server {uri} answers HTTP {err.code}: {fix}") from None
+        body = None
+        status = f"HTTP {err.code}"
+    except (OSError, ValueError) as err:  # URLError, timeouts, refused connections
+        why = getattr(err, "reason", err)
+        raise TrackingError(f"tracking server {uri} does not answer ({why}): {fix}") from None
+    else:
+        status = "no JSON object"
+        try:
+            body = json.loads(body)
+        except ValueError:
+            body = None
+    if not isinstance(body, dict):
+        raise TrackingError(f"{uri} answers but is not an MLflow tracking server (GET "
+                            f"{MLFLOW_PROBE}: {status}): {fix}")  # fmt: skip
+
+
+def _check_sqlite(db: Path) -> None:
+    """Raise :class:`TrackingError` naming ``db`` when it exists but is not an intact SQLite
+    database (another kind of file, truncated, damaged); a missing file is a new store."""
+    if not db.exists():
+        return
+    fix = "move it aside (a new store is created) or set logger.uri / MLFLOW_TRACKING_URI"
+    try:
+        with open(db, "rb") as f:
+            if db.stat().st_size and f.read(16) != b"SQLite format 3\x00":
+                raise sqlite3.DatabaseError("file is not a database")
+        con = sqlite3.connect(
+            f"{db.resolve().as_uri()}?mode=ro", uri=True, timeout=LOCK_WAIT_SECONDS
+        )
+        try:
+            problems = [r[0] for r in con.execute("PRAGMA quick_check")]
+        finally:
+            con.close()
+    except (sqlite3.Error, OSError) as err:
+        raise TrackingError(f"tracking store {db} is not a readable SQLite database ({err}): "
+                            f"{fix}") from None  # fmt: skip
+    if problems != ["ok"]:
+        why = " ".join(str(problems[0]).split())[:200]
+        raise TrackingError(f"tracking store {db} is damaged ({why}): {fix}")
 
 
 def open_store(uri: str, wait: float = LOCK_WAIT_SECONDS):
