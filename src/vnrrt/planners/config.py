@@ -2,9 +2,10 @@
 (read here, written nowhere else), and :data:`FASTEST`, ``conf/planner/fastest.yaml`` (the
 Hydra option ``planner=fastest``). Lengths in pixels, times in seconds.
 
-Kept free of Hydra/OmegaConf (the YAML files are read with PyYAML) so that
-:mod:`vnrrt.planners` depends only on :mod:`vnrrt.grid`, :mod:`vnrrt.search` and the
-location of ``conf/`` (:data:`vnrrt.config.CONF_DIR`); ``vnrrt.config.section(cfg, "planner",
+The files are read from :data:`CONF_DIR`, ``vnrrt/planners/conf``: in the repository a link
+to ``conf/planner``, in an installed wheel its copy (package data). Kept free of
+Hydra/OmegaConf (the files are read with PyYAML) so that :mod:`vnrrt.planners` depends only
+on :mod:`vnrrt.grid` and :mod:`vnrrt.search`; ``vnrrt.config.section(cfg, "planner",
 PlannerConfig)`` validates the composed YAML against this dataclass.
 """
 
@@ -13,21 +14,22 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import yaml
 
-from vnrrt.config import CONF_DIR
 from vnrrt.names import PLANNERS  # noqa: F401  (re-exported: the one list of planners)
 
 REFERENCES = ("astar", "any_angle", "taut")
 RADIUS_MODES = ("shrinking", "fixed")
+CONF_DIR = Path(__file__).parent / "conf"  # conf/planner (a link to it, or its packaged copy)
 
 
 def load(name: str) -> dict:
     """The settings of ``conf/planner/<name>.yaml`` as a dict, composed as Hydra composes a
     group option: the options named in its ``defaults`` list first, then its own keys
     (``_self_``, last when not listed)."""
-    path = CONF_DIR / "planner" / f"{name}.yaml"
+    path = CONF_DIR / f"{name}.yaml"
     with open(path, encoding="utf-8") as f:
         node = yaml.safe_load(f) or {}
     bases = list(node.pop("defaults", []))
