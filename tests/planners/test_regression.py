@@ -56,7 +56,7 @@ def test_same_seed_same_result_as_before_the_api_change(cluttered, planner, labe
 
 
 # (settings, stop) -> (cost, iterations, tree size, collision checks) of RRT* on the cluttered
-# map with seed (3, 1) and the exact optimum as the reference (267.2472961387225 px), recorded
+# map with seed (3, 1) and the exact optimum as the reference (267.2472961387225 px),
 # pinned with the code of commit 0ae509b
 FASTEST_PINNED = {
     ("fastest", "initial"): (286.1381321602575, 39, 22, 91),
