@@ -1,5 +1,5 @@
 """The clock of :func:`time.perf_counter`, read from compiled code, so that a planner run
-times itself inside its one compiled call (:func:`vnrrt.planners.run.drive`).
+times itself inside its one compiled call (:func:`vnrrt.planners.run.grow_tree`).
 
 :func:`monotonic` returns seconds. On 64-bit Linux ``time.perf_counter()`` is
 ``clock_gettime(CLOCK_MONOTONIC)``, read here directly (about 40 ns a read, through libc's

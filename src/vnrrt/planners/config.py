@@ -91,7 +91,7 @@ class PlannerConfig:
         informed: Informed RRT* (Gammell et al. 2014): once a solution of cost c exists,
             sample (uniform and heatmap draws) inside the ellipse with foci start and goal
             and major axis c, and skip nodes that cannot improve the solution
-            (:mod:`vnrrt.planners.core`). Off in the paper's protocol.
+            (:mod:`vnrrt.planners.rrt_star`). Off in the paper's protocol.
         straight_first: try the straight start-goal segment first (any length): when it is
             free it is the optimum and the run ends at once. Off in the paper's protocol.
         refine: share of the iterations, once a solution exists, that are path-refinement

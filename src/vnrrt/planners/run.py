@@ -1,5 +1,5 @@
 """One timed planner run on a validated query: the run's settings, its tree's arrays, the
-compiled loop that grows the tree (:func:`drive`) and the :class:`PlanResult` built from it.
+compiled loop that grows the tree (:func:`grow_tree`) and the :class:`PlanResult` built from it.
 
 Coordinates follow :mod:`vnrrt.grid`: ``occ`` is the ``(H, W)`` uint8 grid indexed
 ``occ[y, x]`` (nonzero = obstacle), points are continuous ``(x, y)`` pixels, lengths pixels,
@@ -185,62 +185,53 @@ def stop_bounds(query: Query) -> np.ndarray:
 
 
 @njit(cache=True)
-def drive(occ, tree, scratch, counters, trace, rng, draws, stops, p, first, limits, state,
-          times, iters):  # fmt: skip
-    """Plant the tree (when ``state[2]`` is 1) and grow it until the run is over.
+def grow_tree(occ, tree, scratch, counters, trace, rng, draws, stops, p, first, limits, state,
+              times, iters):  # fmt: skip
+    """Plant the tree (when ``state[2]`` is 1) and grow it until the run is over; then its
+    path, segment lengths, trace iterations and costs (:func:`vnrrt.planners.tree.finish`).
 
-    ``stops`` (M,) decreasing cost bounds; ``p`` the run's :class:`Params` (``first``: those
-    of planting); ``limits`` ``(target, max_iterations, max_seconds, t0)`` (target ``inf``:
-    the first solution; ``t0``: the run's start on the clock, seconds); ``state`` (3,) int64
-    kept across calls: next chunk size, bounds passed, plant first; ``times`` (M,) float64
-    and ``iters`` (M,) int64: when each bound was first passed (NaN / -1: never). Returns
-    :data:`SOLVED`, :data:`MAX_ITERATIONS`, :data:`MAX_SECONDS` or
-    :data:`~vnrrt.planners.rrt_star.TREE_FULL`.
+    ``tree``, ``scratch``, ``counters``, ``trace`` (:attr:`Tree.flat`), ``draws`` and ``p``
+    (``first``: those of planting) are plain tuples (:class:`Draws`, :class:`Params`);
+    ``stops`` (M,) decreasing cost bounds; ``limits`` ``(target, max_iterations,
+    max_seconds, t0)`` (target ``inf``: the first solution; ``t0``: the run's start on the
+    clock, seconds); ``state`` (3,) int64 kept across calls: next chunk size, bounds passed,
+    plant first; ``times`` (M,) float64 and ``iters`` (M,) int64: when each bound was first
+    passed (NaN / -1: never). Returns ``(code, path, segs, trace_iters, trace_costs)``, the
+    code :data:`SOLVED`, :data:`MAX_ITERATIONS`, :data:`MAX_SECONDS` or
+    :data:`~vnrrt.planners.rrt_star.TREE_FULL` (the arrays then empty: the caller enlarges
+    the tree and calls again).
     """
+    t, c, tr = nodes.Tree(*tree), nodes.Counters(*counters), nodes.Trace(*trace)
+    scratch, draws, p = nodes.Scratch(*scratch), Draws(*draws), Params(*p)
     target, max_iterations, max_seconds, t0 = limits
     if state[2]:
-        rrt_star.plant(occ, tree, counters, scratch.stack, trace, first, stops)
+        rrt_star.plant(occ, t, c, scratch.stack, tr, Params(*first), stops)
         state[2] = 0
     status = rrt_star.RUNNING
     while True:
         now = monotonic() - t0
-        for b in range(state[1], counters.milestone[0]):
-            times[b], iters[b] = now, counters.iters[0]
-        state[1] = counters.milestone[0]
-        g = counters.goal[0]
-        if g >= 0 and tree.cost[g] <= target:
-            return SOLVED
-        if status == TREE_FULL:
-            return TREE_FULL
-        if counters.iters[0] >= max_iterations:
-            return MAX_ITERATIONS
-        if now >= max_seconds:
-            return MAX_SECONDS
-        if rrt_star.gaps_due(draws, counters.iters[0]) <= 0:
+        for b in range(state[1], c.milestone[0]):
+            times[b], iters[b] = now, c.iters[0]
+        state[1] = c.milestone[0]
+        code = rrt_star.RUNNING
+        if c.goal[0] >= 0 and t.cost[c.goal[0]] <= target:
+            code = SOLVED
+        elif status == TREE_FULL:
+            return TREE_FULL, np.zeros((0, 2)), np.zeros(0), np.zeros(0, np.int64), np.zeros(0)
+        elif c.iters[0] >= max_iterations:
+            code = MAX_ITERATIONS
+        elif now >= max_seconds:
+            code = MAX_SECONDS
+        if code != rrt_star.RUNNING:
+            path, segs, trace_iters, trace_costs = nodes.finish(
+                t.links, t.pts, t.cost, c.goal[0], tr.iters, tr.costs, c.trace_len[0], c.iters[0]
+            )
+            return code, path, segs, trace_iters, trace_costs
+        if rrt_star.gaps_due(draws, c.iters[0]) <= 0:
             draws = rrt_star.with_gaps(occ, draws)
-        n = min(state[0], max_iterations - counters.iters[0],
-                rrt_star.gaps_due(draws, counters.iters[0]))  # fmt: skip
-        status = rrt_star.grow(occ, tree, scratch, counters, trace, rng, draws, stops, p, n)
+        n = min(state[0], max_iterations - c.iters[0], rrt_star.gaps_due(draws, c.iters[0]))
+        status = rrt_star.grow(occ, t, scratch, c, tr, rng, draws, stops, p, n)
         state[0] = min(2 * state[0], MAX_CHUNK)
-
-
-@njit(cache=True)
-def grow_tree(occ, tree, scratch, counters, trace, rng, draws, stops, p, first, limits, state,
-              times, iters):  # fmt: skip
-    """:func:`drive` on plain tuples (:attr:`Tree.flat`, ``draws``, ``p``, ``first``), then,
-    when the run is over, its path, segment lengths, trace iterations and costs
-    (:func:`vnrrt.planners.tree.finish`) in the same call: ``(code, path, segs, trace_iters,
-    trace_costs)``, the arrays empty when the code is
-    :data:`~vnrrt.planners.rrt_star.TREE_FULL`."""
-    t, c, tr = nodes.Tree(*tree), nodes.Counters(*counters), nodes.Trace(*trace)
-    code = drive(occ, t, nodes.Scratch(*scratch), c, tr, rng, Draws(*draws), stops, Params(*p),
-                 Params(*first), limits, state, times, iters)  # fmt: skip
-    if code == TREE_FULL:
-        return code, np.zeros((0, 2)), np.zeros(0), np.zeros(0, np.int64), np.zeros(0)
-    path, segs, trace_iters, trace_costs = nodes.finish(
-        t.links, t.pts, t.cost, c.goal[0], tr.iters, tr.costs, c.trace_len[0], c.iters[0]
-    )
-    return code, path, segs, trace_iters, trace_costs
 
 
 def result(
