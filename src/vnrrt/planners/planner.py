@@ -30,7 +30,7 @@ from vnrrt.planners.collision import segment_free
 from vnrrt.planners.config import PLANNERS, PlannerConfig
 from vnrrt.planners.reference import reference_length as compute_reference
 from vnrrt.planners.result import PlanResult
-from vnrrt.planners.samplers import Sampler, heatmap_sampler, rng_state, uniform_sampler
+from vnrrt.planners.samplers import Sampler, heatmap_sampler, uniform_sampler
 
 log = logging.getLogger(__name__)
 
@@ -100,11 +100,17 @@ def _occupancy(grid) -> np.ndarray:
 
 
 def _endpoint(occ: np.ndarray, point, name: str) -> tuple[float, float]:
-    """``point`` as floats ``(x, y)``: finite, in a free cell, touching no obstacle or border."""
+    """``point`` as floats ``(x, y)``: finite, in a free cell, touching no obstacle or border
+    (one compiled test; a point that fails it is named by :func:`as_point` or here)."""
+    try:
+        x, y = point
+        x, y = float(x), float(y)
+    except (TypeError, ValueError):
+        x = y = math.nan
+    if math.isfinite(x) and math.isfinite(y) and segment_free(occ, x, y, x, y):
+        return x, y
     x, y = as_point(occ, point, name)  # names a malformed point, one outside, one in an obstacle
-    if not segment_free(occ, x, y, x, y):
-        raise GridError(f"{name} {(x, y)} touches an obstacle cell or the map border")
-    return x, y
+    raise GridError(f"{name} {(x, y)} touches an obstacle cell or the map border")
 
 
 def _check_seed(seed) -> None:
@@ -191,6 +197,17 @@ class Planner:
             ValueError: unknown stop rule, bad reference length or seed.
         """
         warmup()  # before the timed run: the kernels compiled (once per process)
+        query = self._query(start, goal, stop=stop, reference_length=reference_length,
+                            seed=seed, milestones=milestones, keep_tree=keep_tree)  # fmt: skip
+        result = run.run(self.occ, query, planner=self.planner, setup=self.setup, seed=seed)
+        if log.isEnabledFor(logging.DEBUG):
+            log.debug("%s", result.summary())
+        return result
+
+    def _query(self, start, goal, *, stop, reference_length, seed, milestones, keep_tree
+               ) -> run.Query:  # fmt: skip
+        """The checked query of :meth:`solve` (arguments and errors there), its reference
+        computed when ``stop`` is ``'optimal'`` and none is given."""
         start, goal = _endpoint(self.occ, start, "start"), _endpoint(self.occ, goal, "goal")
         if stop not in ("initial", "optimal"):
             raise ValueError(f"unknown stop rule {stop!r}; use 'initial' or 'optimal'")
@@ -203,13 +220,8 @@ class Planner:
             raise ValueError(f"reference_length must be finite and >= 0, got {reference_length}")
         target = None if stop == "initial" else (1.0 + self.config.eps) * reference_length
         bounds = tuple(float(m) for m in milestones)
-        query = run.Query(start, goal, target, bounds, keep_tree, reference_length,
-                          self.setup_time, self.sampler.fallback_uniform)  # fmt: skip
-        result = run.run(self.occ, query, planner=self.planner, setup=self.setup,
-                         rng=rng_state(seed))  # fmt: skip
-        if log.isEnabledFor(logging.DEBUG):
-            log.debug("%s", result.summary())
-        return result
+        return run.Query(start, goal, target, bounds, keep_tree, reference_length,
+                         self.setup_time, self.sampler.fallback_uniform)  # fmt: skip
 
 
 def plan(
@@ -254,7 +266,7 @@ def warmup() -> None:
         for informed in (False, True):
             p = Planner(occ, planner, heatmap=hm,
                         config=PlannerConfig(max_iterations=200, informed=informed))  # fmt: skip
-            run.run(occ, query, planner=planner, setup=p.setup, rng=rng_state(0))
+            run.run(occ, query, planner=planner, setup=p.setup, seed=0)
     p = Planner(occ, config=PlannerConfig(max_iterations=200, gap_share=0.5, straight_first=True))
-    run.run(occ, query, planner="rrt_star", setup=p.setup, rng=rng_state(0))
+    run.run(occ, query, planner="rrt_star", setup=p.setup, seed=0)
     log.debug("planner kernels compiled")

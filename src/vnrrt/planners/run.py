@@ -20,6 +20,7 @@ its ``solve()`` times; growing them is inside.
 
 from __future__ import annotations
 
+import functools
 import math
 import time
 from typing import NamedTuple
@@ -34,6 +35,7 @@ from vnrrt.planners.config import PlannerConfig
 from vnrrt.planners.result import Milestone, PlanResult
 from vnrrt.planners.rrt_star import TREE_FULL, Draws, Params
 from vnrrt.planners.samplers import NO_CELLS, Sampler
+from vnrrt.planners.seeding import rng_state
 
 FIRST_CAPACITY = 4096  # tree nodes allocated first; doubled when full (up to the budget)
 FIRST_CHUNK, MAX_CHUNK = 64, 4096  # iterations per chunk; budgets checked between
@@ -92,20 +94,25 @@ class Tree:
 
 class Setup:
     """What every run of one planner on one map shares, made once (as OMPL's ``setup()``):
-    the budgets, the core's settings (:class:`~vnrrt.planners.rrt_star.Params`, the query's
-    start and goal left at 0), the sampler as the core reads it
-    (:class:`~vnrrt.planners.rrt_star.Draws`, a plain tuple) and, from the first tree run on,
-    the tree's arrays (:meth:`fresh`; one run at a time)."""
+    the budgets and, from the first tree run on, the core's settings (:attr:`params`,
+    :class:`~vnrrt.planners.rrt_star.Params`, the query's start and goal left at 0), the
+    sampler as the core reads it (:attr:`draws`) and the tree's arrays (:meth:`fresh`; one
+    run at a time)."""
 
     def __init__(self, occ: np.ndarray, cfg: PlannerConfig, sampler: Sampler):
-        self.shape = occ.shape
+        self.occ, self.cfg, self.sampler = occ, cfg, sampler
         self.max_iterations, self.max_seconds = int(cfg.max_iterations), float(cfg.max_seconds)
         self.trace_capacity, self.straight_first = int(cfg.trace_capacity), cfg.straight_first
         self.bucket = max(min(cfg.eta, max(occ.shape)) / 2, 1.0)  # an unlimited step: the map
-        shrinking = cfg.radius_mode == "shrinking"
-        self.params = Params(
+        self._tree: Tree | None = None
+
+    @functools.cached_property
+    def params(self) -> Params:
+        """The core's settings (made by the first tree run: a straight answer needs none)."""
+        cfg = self.cfg
+        return Params(
             eta=float(cfg.eta),
-            gamma=gamma(occ, cfg) if shrinking else 0.0,
+            gamma=gamma(self.occ, cfg) if cfg.radius_mode == "shrinking" else 0.0,
             radius=float(cfg.fixed_radius),
             goal_radius=float(cfg.eta if cfg.goal_radius is None else cfg.goal_radius),
             sx=0.0, sy=0.0, gx=0.0, gy=0.0,  # the query's: run()
@@ -116,19 +123,23 @@ class Setup:
             pull_parents=bool(cfg.pull_parents),
             refine_branches=float(cfg.refine_branches),
         )  # fmt: skip
+
+    @functools.cached_property
+    def draws(self) -> tuple:
+        """The sampler and the gap sampler as the core reads them (a plain :class:`Draws`)."""
+        cfg, sampler = self.cfg, self.sampler
         cdf = sampler.cdf if sampler.cdf.size else np.zeros(1)
         share = float(cfg.gap_share)  # the gap cells pending (-1) when used: found in the run
-        self.draws = tuple(Draws(float(sampler.draw_mix), cdf, max(sampler.last, 0), share,
-                                 int(cfg.gap_width), int(cfg.gap_after), NO_CELLS,
-                                 -1 if share > 0 else 0))  # fmt: skip
-        self._tree: Tree | None = None
+        return tuple(Draws(float(sampler.draw_mix), cdf, max(sampler.last, 0), share,
+                           int(cfg.gap_width), int(cfg.gap_after), NO_CELLS,
+                           -1 if share > 0 else 0))  # fmt: skip
 
     def fresh(self) -> Tree:
         """An empty tree: allocated (:data:`FIRST_CAPACITY` nodes, or the budget's) by the
         first run, emptied by the next ones (kept as large as it grew)."""
         if self._tree is None:
             capacity = min(self.max_iterations + 2, FIRST_CAPACITY)
-            self._tree = Tree(capacity, self.shape, self.bucket, self.trace_capacity)
+            self._tree = Tree(capacity, self.occ.shape, self.bucket, self.trace_capacity)
         self._tree.reset()
         return self._tree
 
@@ -144,10 +155,9 @@ def gamma(occ: np.ndarray, cfg: PlannerConfig) -> float:
     return factor * 2.0 * math.sqrt(1.5) * math.sqrt(free / math.pi)
 
 
-def run(occ: np.ndarray, query: Query, *, planner: str, setup: Setup, rng: np.ndarray
-        ) -> PlanResult:  # fmt: skip
+def run(occ: np.ndarray, query: Query, *, planner: str, setup: Setup, seed) -> PlanResult:
     """The timed run of ``query`` (module doc) with ``setup``'s settings and arrays, sampling
-    from the xoshiro256** state ``rng`` ``(4,)`` uint64 (advanced in place)."""
+    from the xoshiro256** generator seeded by ``seed`` (:func:`.seeding.rng_state`)."""
     (sx, sy), (gx, gy) = query.start, query.goal
     target, d, spent = query.target, -1.0, 0.0
     if setup.straight_first:
@@ -156,7 +166,7 @@ def run(occ: np.ndarray, query: Query, *, planner: str, setup: Setup, rng: np.nd
         spent = time.perf_counter() - t0
         if d >= 0 and (target is None or d <= target):
             return straight_result(planner, d, spent, query)
-    stops = stop_bounds(query)
+    stops, rng = stop_bounds(query), rng_state(seed)
     tree = setup.fresh()  # allocated (or emptied) before the clock starts, as OMPL's setup()
     params = setup.params._replace(sx=sx, sy=sy, gx=gx, gy=gy)
     first = params._replace(goal_radius=math.inf) if d >= 0 else params  # planting
