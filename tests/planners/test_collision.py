@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from vnrrt.planners import path_free, point_free, segment_free
-from vnrrt.planners.collision import MARGIN, points_free
+from vnrrt.planners.collision import MARGIN
 from vnrrt.planners.rrt_star import straight_cost
 
 
@@ -107,9 +107,9 @@ def test_path_free_checks_every_segment():
 
 @pytest.mark.parametrize("lattice", [False, True])
 def test_a_querys_compiled_checks_match_the_brute_force_reference(grid, lattice):
-    """A query's compiled checks: points_free is False when either endpoint touches an
-    obstacle or the border; straight_cost is the start-goal distance when the segment is free
-    and -1 when it is blocked; checked against :func:`reference_free`."""
+    """A query's compiled checks: an endpoint's zero-length segment is not free when it
+    touches an obstacle or the border; straight_cost is the start-goal distance when the
+    segment is free and -1 when it is blocked; checked against :func:`reference_free`."""
     rng = np.random.default_rng(29 + lattice)
     h, w = grid.shape
     seen = set()
@@ -124,7 +124,8 @@ def test_a_querys_compiled_checks_match_the_brute_force_reference(grid, lattice)
             want = float(np.hypot(*(b - a)))
         else:
             want = -1.0
-        assert points_free(grid, *p) is (want != "bad"), p
+        ends_free = segment_free(grid, *a, *a) and segment_free(grid, *b, *b)
+        assert ends_free is (want != "bad"), p
         if want != "bad":
             assert straight_cost(grid, *p) == pytest.approx(want, abs=1e-12), p
         seen.add(want if want == "bad" else "blocked" if want < 0 else "free")
