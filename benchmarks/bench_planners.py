@@ -18,8 +18,8 @@ of the exact continuous optimum (:func:`vnrrt.planners.any_angle_path`); a run s
 at ``--time-limit`` (a miss counts as the limit: medians marked ">=" are lower bounds).
 ``ours-call`` is the whole ``plan()`` call (input checks, setup, seeding and result
 included); our calls run with the garbage collector off and their garbage is collected
-after them (``--collect-before``: right before each call, the earlier method, which leaves
-the call's caches cold). Per map: medians over trials and the ratio of the best native OMPL
+after them (``--collect-before``: right before each call, which leaves the call's caches
+cold). Per map: medians over trials and the ratio of the best native OMPL
 planner's median to ours; overall: each planner's median over maps, the ratio of the best
 OMPL planner's (native, then Python) to ours, and the median and worst per-map ratio (for
 the whole call too). The floor is the exact visibility-graph solve itself, timed per map.
@@ -31,16 +31,16 @@ Every timed run, ours and OMPL's alike, follows an untimed run of the same plann
 with a 1 ms budget (``--warm SECONDS``, default 0.001), while trials still alternate between the
 planners. (OMPL's own benchmark tool, ``ompl::tools::Benchmark::benchmark``, also runs one
 planner's runs back to back, planners in the outer loop, though with ``clear()``, path checks
-and simplification between runs rather than a warm-up run.) ``--warm 0`` is the default before
-2026-12-03 (a second reading; it changes the verdict on the maps whose straight segment is
-free): there our first call of a trial follows the Python bindings' runs of the one before,
-with cold caches (a free straight segment's run, one segment test of ~1 us warm, then reads ~10
-us), while each native planner follows the others' runs on the same map and its own setup in
-its harness, warmer. ``--flush MB`` (a third reading, with ``--warm 0``) writes and reads that
+and simplification between runs rather than a warm-up run.) ``--warm 0`` is a second reading (it
+changes the verdict on the maps whose straight segment is free): there our first call of a
+trial follows the Python bindings' runs of the one before, with cold caches, while each
+native planner follows the others' runs on the same map and its own setup in its harness,
+warmer. ``--flush MB`` (a third reading, with ``--warm 0``) writes and reads that
 many MB of a buffer in the planner's own process (ours and the Python bindings' here, native
 OMPL's in its harness) after the warm-up run, if any, and right before every timed run, so
 that every planner starts with caches disturbed alike (not emptied: with a last-level cache
-larger than the flush, cold times keep growing with its size; ``bench_cold_call.py``).
+larger than the flush, cold times keep growing with its size). Every reading is written to
+``benchmarks/results/bench_planners.txt`` (its header names the reading, machine and code).
 
     python benchmarks/bench_planners.py [--trials 5] [--time-limit 2] [--sets dev,held_out]
         [--warm 0.001] [--flush 0]
@@ -61,7 +61,6 @@ import ompl_native
 import ompl_python
 from planner_maps import dev_instances, held_out_instances
 from vnrrt.planners import FASTEST, PlannerConfig, any_angle_path, path_free, plan, warmup
-from vnrrt.planners.native import described
 
 ETA, BEST_ETA = 10.0, FASTEST.eta
 OURS = {"ours-best": FASTEST, "ours-rrt*": PlannerConfig(eta=ETA)}
@@ -69,7 +68,7 @@ NATIVE = [*ompl_native.PLANNERS, "RRTstar-m", "InformedRRTstar-m"]
 PYTHON = [*ompl_python.PLANNERS, "RRTstar-m", "InformedRRTstar-m"]
 
 
-COLLECT_BEFORE = False  # --collect-before: the method of the runs before 2026-12-02 (see main)
+COLLECT_BEFORE = False  # --collect-before: garbage collected right before each of our calls
 WARM = 0.001  # --warm: seconds of an untimed run of each planner before each of its timed ones
 FLUSH = 0  # --flush: bytes written and read in a planner's process before each of its timed runs
 _BUFFER = np.zeros(0, np.uint8)  # this process's flush buffer
@@ -261,13 +260,13 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--no-python", action="store_true", help="skip OMPL's Python bindings")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--collect-before", action="store_true",
-                    help="collect garbage right before each of our calls (the runs before "
-                         "2026-12-02: it leaves the next call's caches cold)")  # fmt: skip
+                    help="collect garbage right before each of our calls (it leaves the "
+                         "next call's caches cold)")  # fmt: skip
     ap.add_argument("--warm", type=float, default=0.001, metavar="SECONDS",
                     help="before each timed run, an untimed run of the same planner and query "
                          "with this budget (every planner, ours and OMPL's, starts warm, as each "
                          "run in OMPL's benchmark tool follows the same planner's; default "
-                         "0.001; 0: none, the default before 2026-12-03)")  # fmt: skip
+                         "0.001; 0: none)")  # fmt: skip
     flush = "before each timed run (after --warm's), write and read this many MB in the "
     flush += "planner's process: every planner starts with caches disturbed alike"
     ap.add_argument("--flush", type=float, default=0.0, metavar="MB", help=flush)
@@ -282,7 +281,6 @@ def main(argv: list[str] | None = None) -> int:
     if not args.no_python:
         ompl_python.quiet(args.seed + 1)
     warmup()  # JIT compilation (or cache load) outside every timing
-    print(described())
     sets = {"dev": dev_instances, "held_out": held_out_instances}
     good = True
     with ompl_native.Harness(binary, args.seed + 1) as native:

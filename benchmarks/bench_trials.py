@@ -26,11 +26,11 @@ import numpy as np
 
 from bench_paper_scale import fmt_time, trial_seconds
 from vnrrt.config import compose, section
+from vnrrt.data.instances import EvalInstance
 from vnrrt.evaluation.config import EvalConfig
-from vnrrt.evaluation.instances import EvalInstance
-from vnrrt.evaluation.oracle import instance_heatmap
-from vnrrt.evaluation.protocol import planner_specs, trial_counts, trial_jobs
-from vnrrt.evaluation.trials import HeatSettings, run_trials
+from vnrrt.evaluation.oracles import instance_heatmap
+from vnrrt.evaluation.protocol import configurations, trial_counts, trial_jobs
+from vnrrt.evaluation.trials import LIBRARY_HEAT, HeatSettings, run_trials
 from vnrrt.maps.config import DataConfig
 from vnrrt.maps.generate import generate_map, map_rng
 from vnrrt.maps.named import NAMES, named_map
@@ -38,6 +38,7 @@ from vnrrt.planners import PlannerConfig, any_angle_path, taut_length, warmup
 from vnrrt.search import astar, path_vertices
 
 ORACLE = {"path": "oracle_path", "interior_vertices": "oracle_vertex"}  # network target -> oracle
+HEAT = LIBRARY_HEAT  # the oracles' blur and floor, the mass radii: the library's
 
 
 def instance(i: int, map_set: str, grid, start, goal, sources: dict[str, str]) -> EvalInstance:
@@ -49,7 +50,9 @@ def instance(i: int, map_set: str, grid, start, goal, sources: dict[str, str]) -
     inst = EvalInstance(i, (0, i), map_set, map_set, 0, grid, tuple(start), tuple(goal), length,
                         exact, taut_length(grid, s, g), path, path_vertices(path),
                         exact_path)  # fmt: skip
-    inst.heatmaps.update({n: instance_heatmap(ORACLE[t], inst) for n, t in sources.items()})
+    free = grid == 0
+    inst.heatmaps.update({n: instance_heatmap(ORACLE[t], inst, HEAT.sigma, HEAT.floor, free)
+                          for n, t in sources.items()})  # fmt: skip
     return inst
 
 
@@ -73,7 +76,7 @@ def paper_cost(cfg, specs, table) -> tuple[float, int]:
     kinds = ["named"] * len(NAMES) + ["random"] * ev.random_maps
     rate = trial_seconds(table)
     jobs = trial_jobs(kinds, specs, trial_counts(ev))
-    seconds = sum(j.count * rate[kinds[j.instance], j.stop, j.spec.key] for j in jobs)
+    seconds = sum(j.count * rate[kinds[j.instance], j.stop, j.key.text] for j in jobs)
     return float(seconds), sum(j.count for j in jobs)
 
 
@@ -85,7 +88,7 @@ def main() -> None:
     args = ap.parse_args()
     cfg = compose(["scale=paper"])
     ev, planner = section(cfg, "eval", EvalConfig), section(cfg, "planner", PlannerConfig)
-    specs = planner_specs(ev, [*planner.taus, planner.tau])
+    specs = configurations(ev, planner.taus, planner.tau)
     targets = {"nrrtnet": "path", "vertexnet": "interior_vertices"}
     sources = {n: targets[n] for n in set(ev.sources.values())}
     insts = instances(args.random_maps, sources)
@@ -94,7 +97,7 @@ def main() -> None:
               ("named", "optimal_any_angle"): k, ("random", "initial"): 1,
               ("random", "optimal"): 1, ("random", "optimal_any_angle"): 1}  # fmt: skip
     warmup()
-    heat = HeatSettings(targets=targets)
+    heat = HeatSettings(HEAT.radius, HEAT.endpoint_radius, targets, HEAT.sigma, HEAT.floor)
     t0 = time.perf_counter()
     table = run_trials(insts, specs, counts, seed=0, workers=1, config=planner, heat=heat)
     wall = time.perf_counter() - t0

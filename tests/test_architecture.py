@@ -135,13 +135,7 @@ def test_no_import_points_up():
     assert upward(GRAPH, RANK) == []
 
 
-# planners/api.py <-> native.py: the planners rewrite of issue 50 removes native.py; strict,
-# so this marker fails the run once the cycle is gone and must then be deleted
-KNOWN_CYCLE = pytest.mark.xfail(strict=True, reason="planners/api.py <-> native.py")
-
-
-@pytest.mark.parametrize("name", [pytest.param(p, marks=KNOWN_CYCLE) if p == "planners" else p
-                                  for p in sorted({package(m) for m in MODULES})])  # fmt: skip
+@pytest.mark.parametrize("name", sorted({package(m) for m in MODULES}))
 def test_no_import_cycle(name):
     """Within each package (across packages the layers rule cycles out)."""
     inside = {m: {t for t in ts if package(t) == name} for m, ts in GRAPH.items()

@@ -38,6 +38,6 @@ def test_the_closure_sees_function_level_imports_and_hydra_targets():
     assert "src/vnrrt/evaluation/stats.py" not in trials
     oracle = {str(p) for p in closure(STAGES["oracle"], declared_params("oracle"))}
     assert "src/vnrrt/evaluation/sources.py" in oracle  # imported by a helper the entry calls
-    assert "src/vnrrt/planners/core.py" in oracle
+    assert "src/vnrrt/planners/rrt_star.py" in oracle
     shard = {str(p) for p in closure(STAGES["shard"], declared_params("shard"))}
     assert "src/vnrrt/maps/named.py" not in shard and "src/vnrrt/infra/parallel.py" in shard

@@ -15,7 +15,7 @@ from vnrrt.evaluation.protocol import trial_seed
 from vnrrt.evaluation.table import COLUMNS, CONVERGENCE_COLUMNS
 from vnrrt.evaluation.trials import run_trials
 from vnrrt.planners import PlannerConfig, plan
-from vnrrt.planners import api as planner_api
+from vnrrt.planners import planner as planner_api
 from vnrrt.search import any_angle_path, astar, path_vertices
 
 

@@ -1,11 +1,16 @@
 """RRT*, NRRT*, VNRRT* and M-VNRRT* as one numba RRT* core with pluggable samplers.
 
-Entry point: :func:`plan`. Depends only on :mod:`vnrrt.grid` and :mod:`vnrrt.search`.
+Entry points: :func:`plan` and :class:`Planner` (:mod:`.planner`); settings
+:class:`PlannerConfig` (:mod:`.config`, from ``conf/planner/``). The path of a call:
+:func:`plan` builds a :class:`Planner` and solves; :meth:`Planner.solve` checks the query and
+makes one timed run (:mod:`.run`), whose tree grows in one compiled call of the RRT* core
+(:mod:`.rrt_star`, sampling from :mod:`.samplers`). Depends only on :mod:`vnrrt.grid`,
+:mod:`vnrrt.search` and the location of ``conf/``.
 """
 
-from vnrrt.planners.api import Planner, make_sampler, plan, warmup
 from vnrrt.planners.collision import path_free, point_free, polyline_length, segment_free
 from vnrrt.planners.config import FASTEST, PLANNERS, PlannerConfig, PlannerConfigError
+from vnrrt.planners.planner import Planner, make_sampler, plan, warmup
 from vnrrt.planners.reference import (
     any_angle_length,
     any_angle_path,

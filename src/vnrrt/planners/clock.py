@@ -1,23 +1,24 @@
 """The clock of :func:`time.perf_counter`, read from compiled code, so that a planner run
-can time itself without returning to Python (:func:`vnrrt.planners.loop.drive`).
+times itself inside its one compiled call (:func:`vnrrt.planners.run.grow_tree`).
 
-On 64-bit Linux ``time.perf_counter()`` is ``clock_gettime(CLOCK_MONOTONIC)`` in seconds;
-:func:`monotonic` reads the same clock from inside a numba function (about 40 ns a read,
-through libc's vDSO call). Elsewhere (:data:`IN_KERNEL` False) the planners keep their
-timing in Python and never compile this.
+:func:`monotonic` returns seconds. On 64-bit Linux ``time.perf_counter()`` is
+``clock_gettime(CLOCK_MONOTONIC)``, read here directly (about 40 ns a read, through libc's
+vDSO call); elsewhere it calls ``time.perf_counter`` in numba's object mode (about a
+microsecond a read).
 """
 
 from __future__ import annotations
 
 import sys
+import time
 
 from llvmlite import ir
-from numba import njit, types
+from numba import njit, objmode, types
 from numba.core import cgutils
 from numba.extending import intrinsic
 
 CLOCK_MONOTONIC = 1  # Linux's clock id (every architecture)
-IN_KERNEL = sys.platform.startswith("linux") and sys.maxsize > 2**32  # 64-bit time_t, long
+LINUX_64 = sys.platform.startswith("linux") and sys.maxsize > 2**32  # 64-bit time_t, long
 
 
 @intrinsic
@@ -39,7 +40,18 @@ def _monotonic_ns(typingctx):
     return types.int64(), codegen
 
 
-@njit(cache=True)
-def monotonic() -> float:
-    """Seconds on the clock of ``time.perf_counter()`` (64-bit Linux only: :data:`IN_KERNEL`)."""
-    return _monotonic_ns() / 1e9  # as perf_counter converts: (double) ns / 1e9
+if LINUX_64:
+
+    @njit(cache=True)
+    def monotonic() -> float:
+        """Seconds on the clock of ``time.perf_counter()``."""
+        return _monotonic_ns() / 1e9  # as perf_counter converts: (double) ns / 1e9
+
+else:
+
+    @njit(cache=True)
+    def monotonic() -> float:
+        """Seconds on the clock of ``time.perf_counter()`` (read in object mode)."""
+        with objmode(t="float64"):
+            t = time.perf_counter()
+        return t

@@ -83,13 +83,6 @@ def segment_free(occ: np.ndarray, x0: float, y0: float, x1: float, y1: float) ->
 
 
 @njit(cache=True)
-def points_free(occ: np.ndarray, x0: float, y0: float, x1: float, y1: float) -> bool:
-    """True when neither point ``(x0, y0)`` nor ``(x1, y1)`` touches an obstacle cell or the
-    map border (two zero-length segments: a query's two endpoints in one compiled call)."""
-    return segment_free(occ, x0, y0, x0, y0) and segment_free(occ, x1, y1, x1, y1)
-
-
-@njit(cache=True)
 def path_free(occ: np.ndarray, path: np.ndarray) -> bool:
     """True when every segment of polyline ``path`` ``(K, 2)`` float (x, y) is free.
 

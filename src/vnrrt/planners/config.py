@@ -1,7 +1,11 @@
-"""Planner settings: the typed mirror of ``conf/planner/default.yaml`` (lengths in pixels).
+"""Planner settings: :class:`PlannerConfig`, whose defaults are ``conf/planner/default.yaml``
+(read here, written nowhere else), and :data:`FASTEST`, ``conf/planner/fastest.yaml`` (the
+Hydra option ``planner=fastest``). Lengths in pixels, times in seconds.
 
-Kept free of Hydra/OmegaConf so that :mod:`vnrrt.planners` depends only on
-:mod:`vnrrt.grid` and :mod:`vnrrt.search`; ``vnrrt.config.section(cfg, "planner",
+The files are read from :data:`CONF_DIR`, ``vnrrt/planners/conf``: in the repository a link
+to ``conf/planner``, in an installed wheel its copy (package data). Kept free of
+Hydra/OmegaConf (the files are read with PyYAML) so that :mod:`vnrrt.planners` depends only
+on :mod:`vnrrt.grid` and :mod:`vnrrt.search`; ``vnrrt.config.section(cfg, "planner",
 PlannerConfig)`` validates the composed YAML against this dataclass.
 """
 
@@ -10,18 +14,54 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass, field
+from pathlib import Path
+
+import yaml
 
 from vnrrt.names import PLANNERS  # noqa: F401  (re-exported: the one list of planners)
 
 REFERENCES = ("astar", "any_angle", "taut")
 RADIUS_MODES = ("shrinking", "fixed")
+CONF_DIR = Path(__file__).parent / "conf"  # conf/planner (a link to it, or its packaged copy)
+
+
+def load(name: str) -> dict:
+    """The settings of ``conf/planner/<name>.yaml`` as a dict, composed as Hydra composes a
+    group option: the options named in its ``defaults`` list first, then its own keys
+    (``_self_``, last when not listed)."""
+    path = CONF_DIR / f"{name}.yaml"
+    with open(path, encoding="utf-8") as f:
+        node = yaml.safe_load(f) or {}
+    bases = list(node.pop("defaults", []))
+    merged = {}
+    for base in bases if "_self_" in bases else [*bases, "_self_"]:
+        merged.update(node if base == "_self_" else load(base))
+    return merged
+
+
+def _defaults_from(name: str):
+    """A frozen dataclass whose field defaults are the settings of ``conf/planner/<name>.yaml``
+    (:func:`load`); the file must give every field and no other key."""
+
+    def build(cls):
+        values = load(name)
+        names = set(cls.__annotations__)
+        if set(values) != names:
+            wrong = sorted(names ^ set(values))
+            raise PlannerConfigError(f"conf/planner/{name}.yaml and PlannerConfig differ: {wrong}")
+        for key, value in values.items():
+            kept = value if not isinstance(value, list) else field(default_factory=value.copy)
+            setattr(cls, key, kept)
+        return dataclass(frozen=True)(cls)
+
+    return build
 
 
 class PlannerConfigError(ValueError):
     """A planner setting is invalid; the message names it."""
 
 
-@dataclass(frozen=True)
+@_defaults_from("default")
 class PlannerConfig:
     """RRT* core, samplers, stop rules and budgets (paper, Background and VertexNet RRT*).
 
@@ -51,7 +91,7 @@ class PlannerConfig:
         informed: Informed RRT* (Gammell et al. 2014): once a solution of cost c exists,
             sample (uniform and heatmap draws) inside the ellipse with foci start and goal
             and major axis c, and skip nodes that cannot improve the solution
-            (:mod:`vnrrt.planners.core`). Off in the paper's protocol.
+            (:mod:`vnrrt.planners.rrt_star`). Off in the paper's protocol.
         straight_first: try the straight start-goal segment first (any length): when it is
             free it is the optimum and the run ends at once. Off in the paper's protocol.
         refine: share of the iterations, once a solution exists, that are path-refinement
@@ -79,29 +119,29 @@ class PlannerConfig:
     cost nothing).
     """
 
-    eta: float = 10.0
-    radius_mode: str = "shrinking"
-    gamma: float | None = None
-    gamma_factor: float = 1.0
-    fixed_radius: float = 10.0
-    goal_radius: float | None = None
-    mix: float = 0.5
-    tau: float = 0.5
-    taus: list[float] = field(default_factory=lambda: [0.5, 0.9, 0.99])
-    eps: float = 0.01
-    reference: str = "astar"
-    min_spacing: float = 0.5
-    informed: bool = False
-    straight_first: bool = False
-    refine: float = 0.0
-    pull_parents: bool = False
-    refine_branches: float = 0.0
-    gap_share: float = 0.0
-    gap_width: int = 8
-    gap_after: int = 0
-    max_iterations: int = 200_000
-    max_seconds: float = 30.0
-    trace_capacity: int = 1024
+    eta: float
+    radius_mode: str
+    gamma: float | None
+    gamma_factor: float
+    fixed_radius: float
+    goal_radius: float | None
+    mix: float
+    tau: float
+    taus: list[float]
+    eps: float
+    reference: str
+    min_spacing: float
+    informed: bool
+    straight_first: bool
+    refine: float
+    pull_parents: bool
+    refine_branches: float
+    gap_share: float
+    gap_width: int
+    gap_after: int
+    max_iterations: int
+    max_seconds: float
+    trace_capacity: int
 
     def validate(self) -> None:
         """Raise :class:`PlannerConfigError` naming the first invalid value."""
@@ -174,16 +214,4 @@ def _finite(v) -> bool:
     return isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)
 
 
-FASTEST = PlannerConfig(
-    eta=20.0,
-    goal_radius=math.inf,
-    informed=True,
-    straight_first=True,
-    refine=0.5,
-    pull_parents=True,
-    refine_branches=0.5,
-    gap_share=0.3,
-    gap_width=8,
-    gap_after=256,
-)  # our fastest settings (benchmarks/bench_planners.py's ``ours-best``), any planner; the gap
-# sampler's three chosen on the development maps only (benchmarks/select_gaps.py)
+FASTEST = PlannerConfig(**load("fastest"))  # our fastest settings, any planner

@@ -1,6 +1,6 @@
 """Path refinement: local moves on the best path, interleaved with the RRT* iterations.
 
-Once a solution exists, ``Params.refine`` of the iterations (:func:`vnrrt.planners.core.grow`)
+Once a solution exists, ``Params.refine`` of the iterations (:func:`vnrrt.planners.rrt_star.grow`)
 pick a random interior vertex ``v`` of the best path (or, ``Params.refine_branches`` of them,
 of the branch from the root to a random tree node whose cost-to-come plus straight line to the
 goal is below the best cost: a path through it could still win), between its parent ``a`` and

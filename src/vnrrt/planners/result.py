@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -76,19 +76,6 @@ class PlanResult:
     tree_points: np.ndarray | None = field(default=None, repr=False)
     tree_parents: np.ndarray | None = field(default=None, repr=False)
 
-    @classmethod
-    def of(cls, values: dict) -> PlanResult:
-        """The result holding ``values``, a value for every field (a ``TypeError`` names a
-        missing or unknown one); the result takes ``values`` as its ``__dict__`` (pass a
-        dict made for it, not one you keep): the same object as ``PlanResult(**values)``
-        without the generated ``__init__``, which sets each of the 21 fields of a frozen
-        dataclass through ``object.__setattr__``, and without copying them into a new dict.
-        The planners build their results with :func:`made`, which skips the check."""
-        if values.keys() != FIELDS:
-            wrong = sorted(FIELDS ^ values.keys())
-            raise TypeError(f"PlanResult.of needs every field; missing or unknown: {wrong}")
-        return made(values)
-
     def summary(self) -> str:
         """One line: planner, success, cost, iterations, nodes and times."""
         ref = "" if self.reference_length is None else f" ref={self.reference_length:.2f}"
@@ -98,16 +85,3 @@ class PlanResult:
             f"checks={self.collision_checks} first={self.time_to_first * 1e3:.2f} ms "
             f"stop={self.time_to_stop * 1e3:.2f} ms"
         )
-
-
-FIELDS = frozenset(f.name for f in fields(PlanResult))
-
-
-def made(values: dict) -> PlanResult:
-    """:meth:`PlanResult.of` without its check of the keys: for the planners' own result
-    builders (:mod:`.run`), whose dicts name every field (tested): in a solve that one
-    segment test answers (~4-5 us), the check's set comparison alone is ~0.3 us. ``values``
-    becomes the result's ``__dict__``."""
-    result = object.__new__(PlanResult)
-    object.__setattr__(result, "__dict__", values)
-    return result

@@ -1,33 +1,46 @@
-"""One planner run on validated inputs: the timed region of :meth:`vnrrt.planners.Planner.solve`.
+"""One timed planner run on a validated query: the run's settings, its tree's arrays, the
+compiled loop that grows the tree (:func:`grow_tree`) and the :class:`PlanResult` built from it.
 
-The clock starts before the straight start-goal segment is tested (when ``straight_first``) and
-stops when the stop rule or a budget is met and a grown tree's path and trace are taken out of
-it (:func:`finished`, in the same compiled call: as OMPL's ``solve()`` builds its solution
-path). The tree's arrays are allocated (or emptied for reuse) before it starts, as OMPL's
-``setup()`` is outside its ``solve()`` times; growing them is inside. A free straight segment
-that meets the stop rule is the exact optimum, known after that one segment test: its result
-(a two-node tree) is written after the clock has stopped, as every result object is
-(:func:`free_answer`; :mod:`.native` makes the same answer in one C call). Otherwise the tree
-grows in compiled chunks of :func:`vnrrt.planners.core.grow`, budgets checked between chunks:
-all in one compiled call on 64-bit Linux (:func:`drive_compiled`, :mod:`.loop`), else
-returning to Python after each chunk (:func:`drive_python`); both grow the same tree. A
-one-shot :func:`vnrrt.planners.plan` takes its tree's arrays from :data:`POOL`."""
+Coordinates follow :mod:`vnrrt.grid`: ``occ`` is the ``(H, W)`` uint8 grid indexed
+``occ[y, x]`` (nonzero = obstacle), points are continuous ``(x, y)`` pixels, lengths pixels,
+times seconds on ``time.perf_counter``'s clock.
+
+The clock starts before the straight start-goal segment is tested (when ``straight_first``)
+and stops when the stop rule or a budget is met and a grown tree's path and trace are taken
+out of it (as OMPL's ``solve()`` builds its solution path). A free straight segment that
+meets the stop rule is the exact optimum: the run ends there, its result a two-node tree.
+Otherwise the tree grows in one compiled call (:func:`grow_tree`): chunks of
+:func:`vnrrt.planners.rrt_star.grow` (first :data:`FIRST_CHUNK` iterations, doubling up to
+:data:`MAX_CHUNK`), the budgets checked and the stop bounds' first-pass times taken between
+chunks; it returns to Python only when the run is over or the tree's arrays are full (then
+enlarged, and the call made again). The tree's arrays are allocated (or emptied for reuse by
+the next run of the same planner) before the clock starts, as OMPL's ``setup()`` is outside
+its ``solve()`` times; growing them is inside.
+"""
 
 from __future__ import annotations
 
+import functools
 import math
-import threading
 import time
 from typing import NamedTuple
 
 import numpy as np
+from numba import njit
 
-from vnrrt.planners import clock, core, loop
+from vnrrt.planners import rrt_star
 from vnrrt.planners import tree as nodes
-from vnrrt.planners.loop import FIRST_CHUNK, MAX_CHUNK
-from vnrrt.planners.result import Milestone, PlanResult, made
+from vnrrt.planners.clock import monotonic
+from vnrrt.planners.config import PlannerConfig
+from vnrrt.planners.result import Milestone, PlanResult
+from vnrrt.planners.rrt_star import TREE_FULL, Draws, Params
+from vnrrt.planners.samplers import NO_CELLS, Sampler
+from vnrrt.planners.seeding import rng_state
 
 FIRST_CAPACITY = 4096  # tree nodes allocated first; doubled when full (up to the budget)
+FIRST_CHUNK, MAX_CHUNK = 64, 4096  # iterations per chunk; budgets checked between
+SOLVED, MAX_ITERATIONS, MAX_SECONDS = 3, 4, 5  # return codes of :func:`drive` (or TREE_FULL)
+REASONS = {SOLVED: "solved", MAX_ITERATIONS: "max_iterations", MAX_SECONDS: "max_seconds"}
 
 
 class Query(NamedTuple):
@@ -45,16 +58,10 @@ class Query(NamedTuple):
     fallback_uniform: bool
 
 
-class Budget(NamedTuple):
-    """A run's budgets and trace size (:class:`vnrrt.planners.PlannerConfig`)."""
-
-    max_iterations: int
-    max_seconds: float
-    trace_capacity: int
-
-
 class Tree:
-    """The state of one growing run: tree, scratch buffers, counters and trace (:mod:`.core`)."""
+    """The arrays of a growing run (:mod:`.tree`): nodes, scratch buffers, counters, trace;
+    ``flat``: the same as plain tuples, as :func:`grow_tree` takes them (numba types a call's
+    plain tuples of arrays about 3x faster than named tuples)."""
 
     def __init__(self, capacity: int, shape: tuple[int, int], bucket: float, trace: int):
         self.tree = nodes.new_tree(capacity, shape, bucket)
@@ -64,23 +71,18 @@ class Tree:
         self._flatten()
 
     def _flatten(self) -> None:
-        """The arrays as plain tuples, as :func:`vnrrt.planners.core.grow_flat` takes them."""
         self.flat = tuple(self.tree), tuple(self.scratch), tuple(self.counters), tuple(self.trace)
 
-    def enlarge(self, capacity: int) -> None:
-        """Room for ``capacity`` nodes, the tree kept."""
+    def enlarge(self, max_iterations: int) -> None:
+        """Double a full tree's room, up to the budget's (root, goal and a node per
+        iteration), the tree kept."""
+        capacity = len(self.tree.cost)
+        if capacity >= max_iterations + 2:
+            raise RuntimeError(f"tree of {capacity} nodes full before the budget")
+        capacity = min(2 * capacity, max_iterations + 2)
         self.tree = nodes.enlarge(self.tree, capacity)
         self.scratch = nodes.new_scratch(capacity)
         self._flatten()
-
-    @property
-    def capacity(self) -> int:
-        return len(self.tree.cost)
-
-    def solved(self, target: float | None) -> bool:
-        """Whether the goal is in the tree at a cost meeting ``target`` (None: any cost)."""
-        g = int(self.counters.goal[0])
-        return g >= 0 and (target is None or self.tree.cost[g] <= target)
 
     def reset(self) -> None:
         """Empty the tree, its arrays kept (a node's fields are written when it is added)."""
@@ -90,399 +92,225 @@ class Tree:
         self.tree.head.fill(-1)
 
 
-class Workspace:
-    """The arrays of the runs of one :class:`vnrrt.planners.Planner` on one map: allocated by
-    the first run (``FIRST_CAPACITY`` nodes, grown as needed), emptied and reused by the next
-    ones. One run at a time. A one-shot workspace (``pooled``, what :func:`vnrrt.planners.plan`
-    uses) takes its first tree from :data:`POOL` and gives it back by :meth:`release`."""
+class Setup:
+    """What every run of one planner on one map shares, made once (as OMPL's ``setup()``):
+    the budgets and, from the first tree run on, the core's settings (:attr:`params`,
+    :class:`~vnrrt.planners.rrt_star.Params`, the query's start and goal left at 0), the
+    sampler as the core reads it (:attr:`draws`) and the tree's arrays (:meth:`fresh`; one
+    run at a time)."""
 
-    def __init__(self, shape: tuple[int, int], bucket: float, budget: Budget, pooled=False):
-        self.shape, self.bucket, self.budget = shape, bucket, budget
-        self.pooled = pooled
+    def __init__(self, occ: np.ndarray, cfg: PlannerConfig, sampler: Sampler):
+        self.occ, self.cfg, self.sampler = occ, cfg, sampler
+        self.max_iterations, self.max_seconds = int(cfg.max_iterations), float(cfg.max_seconds)
+        self.trace_capacity, self.straight_first = int(cfg.trace_capacity), cfg.straight_first
+        self.bucket = max(min(cfg.eta, max(occ.shape)) / 2, 1.0)  # an unlimited step: the map
         self._tree: Tree | None = None
 
-    @property
-    def _key(self) -> tuple:
-        capacity = min(self.budget.max_iterations + 2, FIRST_CAPACITY)
-        return capacity, tuple(self.shape), self.bucket, self.budget.trace_capacity
+    @functools.cached_property
+    def params(self) -> Params:
+        """The core's settings (made by the first tree run: a straight answer needs none)."""
+        cfg = self.cfg
+        return Params(
+            eta=float(cfg.eta),
+            gamma=gamma(self.occ, cfg) if cfg.radius_mode == "shrinking" else 0.0,
+            radius=float(cfg.fixed_radius),
+            goal_radius=float(cfg.eta if cfg.goal_radius is None else cfg.goal_radius),
+            sx=0.0, sy=0.0, gx=0.0, gy=0.0,  # the query's: run()
+            min_spacing=float(cfg.min_spacing),
+            bucket=self.bucket,
+            informed=bool(cfg.informed),
+            refine=float(cfg.refine),
+            pull_parents=bool(cfg.pull_parents),
+            refine_branches=float(cfg.refine_branches),
+        )  # fmt: skip
+
+    @functools.cached_property
+    def draws(self) -> tuple:
+        """The sampler and the gap sampler as the core reads them (a plain :class:`Draws`)."""
+        cfg, sampler = self.cfg, self.sampler
+        cdf = sampler.cdf if sampler.cdf.size else np.zeros(1)
+        share = float(cfg.gap_share)  # the gap cells pending (-1) when used: found in the run
+        return tuple(Draws(float(sampler.draw_mix), cdf, max(sampler.last, 0), share,
+                           int(cfg.gap_width), int(cfg.gap_after), NO_CELLS,
+                           -1 if share > 0 else 0))  # fmt: skip
 
     def fresh(self) -> Tree:
-        """An empty tree (newly allocated, or taken from the pool, the first time)."""
+        """An empty tree: allocated (:data:`FIRST_CAPACITY` nodes, or the budget's) by the
+        first run, emptied by the next ones (kept as large as it grew)."""
         if self._tree is None:
-            key = self._key
-            self._tree = POOL.take(key) if self.pooled else None
-            if self._tree is None:
-                self._tree = Tree(key[0], self.shape, self.bucket, key[3])
+            capacity = min(self.max_iterations + 2, FIRST_CAPACITY)
+            self._tree = Tree(capacity, self.occ.shape, self.bucket, self.trace_capacity)
         self._tree.reset()
         return self._tree
 
-    def release(self) -> None:
-        """Give the tree back to the pool (a pooled workspace of first size; no run may use
-        it afterwards). A tree that grew is dropped, so the pool never holds a large one."""
-        tree, self._tree, key = self._tree, None, self._key
-        if self.pooled and tree is not None and tree.capacity == key[0]:
-            POOL.give(key, tree)
+
+def gamma(occ: np.ndarray, cfg: PlannerConfig) -> float:
+    """The shrinking-radius constant: ``cfg.gamma_factor`` x (``cfg.gamma``, or the RRT*
+    bound ``2 (1 + 1/d)^(1/d) (free area / unit-ball area)^(1/d)``, d = 2, of the map
+    ``occ``, its free area in cells)."""
+    factor = float(cfg.gamma_factor)
+    if cfg.gamma is not None:
+        return factor * float(cfg.gamma)
+    free = occ.size - np.count_nonzero(occ)
+    return factor * 2.0 * math.sqrt(1.5) * math.sqrt(free / math.pi)
 
 
-class TreePool:
-    """Emptied trees of finished one-shot runs, for the next one on a map of the same shape
-    and settings (the allocation and first touch of a tree's ~0.4 MB cost a one-shot call
-    more than a short run): at most ``per_key`` trees for each of the ``keys`` most recent
-    keys ``(capacity, shape, bucket, trace capacity)``. Thread-safe; results never share
-    a tree's arrays (:func:`result` copies what it returns)."""
-
-    def __init__(self, keys: int = 8, per_key: int = 2):
-        self.keys, self.per_key = keys, per_key
-        self._trees: dict[tuple, list[Tree]] = {}
-        self._lock = threading.Lock()
-
-    def take(self, key: tuple) -> Tree | None:
-        with self._lock:
-            trees = self._trees.get(key)
-            return trees.pop() if trees else None
-
-    def give(self, key: tuple, tree: Tree) -> None:
-        with self._lock:
-            trees = self._trees.pop(key, [])  # re-inserted: the most recent key last
-            if len(trees) < self.per_key:
-                trees.append(tree)
-            self._trees[key] = trees
-            while len(self._trees) > self.keys:
-                del self._trees[next(iter(self._trees))]
-
-    def clear(self) -> None:
-        with self._lock:
-            self._trees.clear()
-
-
-POOL = TreePool()
+def run(occ: np.ndarray, query: Query, *, planner: str, setup: Setup, seed) -> PlanResult:
+    """The timed run of ``query`` (module doc) with ``setup``'s settings and arrays, sampling
+    from the xoshiro256** generator seeded by ``seed`` (:func:`.seeding.rng_state`)."""
+    (sx, sy), (gx, gy) = query.start, query.goal
+    target, d, spent = query.target, -1.0, 0.0
+    if setup.straight_first:
+        t0 = time.perf_counter()
+        d = rrt_star.straight_cost(occ, sx, sy, gx, gy)  # -1: blocked
+        spent = time.perf_counter() - t0
+        if d >= 0 and (target is None or d <= target):
+            return straight_result(planner, d, spent, query)
+    stops, rng = stop_bounds(query), rng_state(seed)
+    tree = setup.fresh()  # allocated (or emptied) before the clock starts, as OMPL's setup()
+    params = setup.params._replace(sx=sx, sy=sy, gx=gx, gy=gy)
+    first = params._replace(goal_radius=math.inf) if d >= 0 else params  # planting
+    times, iters = np.full(len(stops), math.nan), np.full(len(stops), -1, np.int64)
+    state = np.array([FIRST_CHUNK, 0, 1], np.int64)  # chunk, bounds passed, plant
+    t0 = time.perf_counter() - spent
+    limits = (math.inf if target is None else float(target), setup.max_iterations,
+              setup.max_seconds, t0)  # fmt: skip
+    while True:  # after a full tree, the gap cells found in the call are found again (same)
+        code, *arrays = grow_tree(occ, *tree.flat, rng, setup.draws, stops, tuple(params),
+                                  tuple(first), limits, state, times, iters)  # fmt: skip
+        if code != TREE_FULL:
+            break
+        tree.enlarge(setup.max_iterations)
+    elapsed = time.perf_counter() - t0
+    reached = dict(zip(stops.tolist(), zip(times.tolist(), iters.tolist()), strict=True))
+    return result(tree, planner, query, reason=REASONS[code], reached=reached,
+                  elapsed=elapsed, arrays=arrays)  # fmt: skip
 
 
 def stop_bounds(query: Query) -> np.ndarray:
     """The cost bounds the core reports passing, decreasing: ``inf`` (any solution), the
     extra bounds and the stop bound."""
-    target = query.target
-    if not query.bounds:  # the common case, without the set and the sort
-        return np.array((math.inf,) if target is None or target == math.inf else (math.inf, target))
-    wanted = {math.inf, *query.bounds, *([] if target is None else [target])}
-    return np.array(sorted(wanted, reverse=True))
+    target = [] if query.target is None else [query.target]
+    return np.array(sorted({math.inf, *query.bounds, *target}, reverse=True))
 
 
-def straight_test(occ: np.ndarray, sx: float, sy: float, gx: float, gy: float,
-                  straight: bool) -> tuple[float, float]:  # fmt: skip
-    """A query's compiled checks (:func:`vnrrt.planners.core.query_test`): the start-goal
-    distance when ``straight`` and the segment between them is free, -1 when it is blocked
-    or not tested, :data:`~vnrrt.planners.core.BAD_ENDPOINT` when start or goal touches an
-    obstacle or the border; and, with ``straight``, the seconds the call took (the first
-    part of a run's time; the endpoints' two point tests are in it), else 0."""
-    t0 = time.perf_counter()
-    d = core.query_test(occ, sx, sy, gx, gy, straight)
-    return d, (time.perf_counter() - t0 if straight else 0.0)
+@njit(cache=True)
+def grow_tree(occ, tree, scratch, counters, trace, rng, draws, stops, p, first, limits, state,
+              times, iters):  # fmt: skip
+    """Plant the tree (when ``state[2]`` is 1) and grow it until the run is over; then its
+    path, segment lengths, trace iterations and costs (:func:`vnrrt.planners.tree.finish`).
 
-
-def straight_meets(d: float, target: float | None) -> bool:
-    """Whether a straight segment of length ``d`` (:func:`straight_test`'s: < 0 when blocked
-    or not tested) answers a query with stop bound ``target`` (None: any length)."""
-    return d >= 0 and (target is None or d <= target)
-
-
-def straight_answer(planner: str, query: Query, tested: tuple[float, float]) -> PlanResult | None:
-    """The run's result when the straight segment ``tested`` (:func:`straight_test`: its
-    length, -1 when blocked, and the seconds taken) meets the query's stop rule, else None
-    (a tree is needed)."""
-    d, found = tested
-    if straight_meets(d, query.target):
-        return straight_result(planner, d, found, *query)
-    return None
-
-
-def free_answer(
-    occ: np.ndarray,
-    sx: float,
-    sy: float,
-    gx: float,
-    gy: float,
-    target: float | None,
-    planner: str,
-    reference_length: float | None,
-    setup_time: float,
-    fallback_uniform: bool,
-) -> PlanResult | tuple[float, float]:
-    """The answer of a query whose straight segment is tested first: :func:`straight_result`
-    when the segment from ``(sx, sy)`` to ``(gx, gy)`` is free and meets ``target`` (None: any
-    length), else :func:`straight_test`'s ``(d, seconds)``. The Python version of
-    :mod:`vnrrt.planners.native`'s C one."""
-    tested = straight_test(occ, sx, sy, gx, gy, True)
-    d, found = tested
-    if not straight_meets(d, target):
-        return tested
-    return straight_result(planner, d, found, (sx, sy), (gx, gy), target, (), False,
-                           reference_length, setup_time, fallback_uniform)  # fmt: skip
-
-
-def straight_result(
-    planner: str,
-    d: float,
-    found: float,
-    start: tuple[float, float],
-    goal: tuple[float, float],
-    target: float | None,
-    bounds: tuple = (),
-    keep_tree: bool = False,
-    reference_length: float | None = None,
-    setup_time: float = 0.0,
-    fallback_uniform: bool = False,
-) -> PlanResult:
-    """The result of a run answered after ``found`` seconds by the free straight segment of
-    length ``d`` from ``start`` to ``goal``, the other arguments those of its
-    :class:`Query` (in its order): the tree is the root and the goal joined to it (one
-    segment test). The cost is ``d``, equal to the polyline length of the path (both are
-    libm's ``hypot``)."""
-    path = np.array((start, goal))
-    values = STRAIGHT.copy()  # the fields every straight answer shares, then its own
-    values["planner"] = planner
-    values["path"] = path
-    values["cost"] = values["first_cost"] = d
-    values["time_to_first"] = values["time_to_stop"] = found
-    values["trace_iterations"] = ROOT_TRACE.copy()
-    values["trace_costs"] = np.array((d,))
-    values["reference_length"] = reference_length
-    values["target_cost"] = target
-    values["fallback_uniform"] = fallback_uniform
-    values["setup_time"] = setup_time
-    if bounds:
-        values["milestones"] = tuple(Milestone(b, found, 0) if d <= b else Milestone(b)
-                                     for b in bounds)  # fmt: skip
-    if keep_tree:
-        values["tree_points"] = path.copy()
-        values["tree_parents"] = np.array((-1, 0), np.int64)
-    return made(values)
-
-
-STRAIGHT = {
-    "planner": "",
-    "success": True,
-    "stop_reason": "solved",
-    "path": None,
-    "cost": 0.0,
-    "iterations": 0,
-    "tree_size": 2,
-    "collision_checks": 1,
-    "time_to_first": 0.0,
-    "time_to_stop": 0.0,
-    "first_cost": 0.0,
-    "first_iteration": 0,
-    "trace_iterations": None,
-    "trace_costs": None,
-    "reference_length": None,
-    "target_cost": None,
-    "milestones": (),
-    "fallback_uniform": False,
-    "setup_time": 0.0,
-    "tree_points": None,
-    "tree_parents": None,
-}  # a straight answer's fields (:func:`straight_result` sets those that vary); a copy per result
-ROOT_TRACE = np.zeros(1, np.int64)  # a straight answer's trace iterations (copied per result)
-
-
-class Setup(NamedTuple):
-    """What every tree run of one :class:`vnrrt.planners.Planner` shares, made once before
-    its first run (as OMPL's ``setup()``): the tree's arrays (``work``), the core's settings
-    (:class:`vnrrt.planners.core.Params`) as a plain tuple whose query fields ``sx, sy, gx,
-    gy`` are placeholders (:func:`query_params` fills them), and the sampler as the core
-    reads it (``draws``, and ``flat_draws``: the same as a plain tuple, what the compiled
-    loop takes)."""
-
-    work: Workspace
-    params: tuple
-    draws: core.Draws
-    flat_draws: tuple
-
-
-SX = core.Params._fields.index("sx")  # sx, sy, gx, gy follow in this order: the query's
-GOAL_RADIUS = core.Params._fields.index("goal_radius")
-assert core.Params._fields[SX : SX + 4] == ("sx", "sy", "gx", "gy")
-
-
-def query_params(params: tuple, query: Query, straight: bool) -> tuple[tuple, tuple]:
-    """The core's settings of a run (``params``: :attr:`Setup.params`) with the query's
-    start and goal, and those of planting (``first``): the same, with any node joining the
-    goal when the straight segment is known to be free (``straight``). Plain tuples in
-    :class:`vnrrt.planners.core.Params`' order."""
-    p = params[:SX] + query.start + query.goal + params[SX + 4 :]
-    first = (*p[:GOAL_RADIUS], math.inf, *p[GOAL_RADIUS + 1 :]) if straight else p
-    return p, first
-
-
-def search(
-    occ: np.ndarray,
-    query: Query,
-    *,
-    planner: str,
-    setup: Setup,
-    rng: np.ndarray,
-    straight: bool,
-    spent: float = 0.0,
-) -> PlanResult:
-    """Grow a tree (in ``setup.work``) from the start until the stop rule or a budget is met;
-    ``straight``: the start-goal segment is known to be free (the goal joins the root at
-    once); ``spent``: seconds of the run before this call (the straight-segment test)."""
-    stops = stop_bounds(query)
-    run = setup.work.fresh()  # allocated (or emptied) before the clock starts, as OMPL's setup()
-    params, first = query_params(setup.params, query, straight)
-    drive = drive_compiled if clock.IN_KERNEL else drive_python
-    t0 = time.perf_counter() - spent
-    job = Job(setup, params, first, rng, stops, query.target, t0)
-    reason, times, iters, finished = drive(run, occ, job)
-    elapsed = time.perf_counter() - t0
-    reached = dict(zip(stops.tolist(), zip(times.tolist(), iters.tolist()), strict=True))
-    return result(run, planner, query, reason=reason, reached=reached, elapsed=elapsed,
-                  finished=finished)  # fmt: skip
-
-
-REASONS = {loop.SOLVED: "solved", loop.MAX_ITERATIONS: "max_iterations",
-           loop.MAX_SECONDS: "max_seconds"}  # fmt: skip
-
-
-class Job(NamedTuple):
-    """What a run's loop reads besides the tree and the grid: the planner's :class:`Setup`
-    (its sampler and budgets), the run's settings (``params``; ``first``: those of planting;
-    plain tuples in :class:`vnrrt.planners.core.Params`' order), the rng state, the stop
-    bounds (decreasing), the stop bound to meet (None: the first solution) and the run's
-    start ``t0`` (``time.perf_counter`` seconds)."""
-
-    setup: Setup
-    params: tuple
-    first: tuple
-    rng: np.ndarray
-    stops: np.ndarray
-    target: float | None
-    t0: float
-
-
-def drive_compiled(
-    run: Tree, occ: np.ndarray, job: Job
-) -> tuple[str, np.ndarray, np.ndarray, tuple]:
-    """:func:`drive_python` in one compiled call (:func:`vnrrt.planners.loop.run_flat`, the
-    result's arrays made in it), back in Python only to enlarge a full tree; the same tree,
-    iterations, costs and arrays."""
-    (times, iters), budget = unreached(len(job.stops)), job.setup.work.budget
-    state = np.array([FIRST_CHUNK, 0, 1], np.int64)  # chunk, bounds passed, plant
-    target = math.inf if job.target is None else float(job.target)
-    limits = (target, int(budget.max_iterations), float(budget.max_seconds), job.t0)
-    rest = (job.setup.flat_draws, job.stops, job.params, job.first, limits, state, times, iters)
-    while True:  # after a full tree, the gap cells found in the call are found again (same)
-        out = loop.run_flat(occ, *run.flat, job.rng, *rest)
-        if out[0] != core.TREE_FULL:
-            return REASONS[out[0]], times, iters, out[1:]
-        make_room(run, budget)
-
-
-def unreached(m: int) -> tuple[np.ndarray, np.ndarray]:
-    """The times (s, float64, NaN) and iterations (int64, -1) at which ``m`` stop bounds
-    were first passed, before a run."""
-    times, iters = np.empty(m), np.empty(m, np.int64)
-    times.fill(math.nan)
-    iters.fill(-1)
-    return times, iters
-
-
-def make_room(run: Tree, budget: Budget) -> None:
-    """Double a full tree's room, up to the budget's (root, goal and a node per iteration)."""
-    if run.capacity >= budget.max_iterations + 2:
-        raise RuntimeError(f"tree of {run.capacity} nodes full before the budget")
-    run.enlarge(min(2 * run.capacity, budget.max_iterations + 2))
-
-
-def drive_python(run: Tree, occ: np.ndarray, job: Job) -> tuple[str, np.ndarray, np.ndarray, tuple]:
-    """Plant the tree and grow it in compiled chunks until the stop rule or a budget is met,
-    timing it in Python (where :data:`vnrrt.planners.clock.IN_KERNEL` is False).
-
-    Returns ``(stop_reason, times, iterations, finished)``: per entry of ``stops``
-    (decreasing cost bounds), the time (s since ``t0``, ``time.perf_counter``) and iteration
-    at which it was first reached (NaN / -1: never), float64 and int64 as
-    :func:`drive_compiled` returns them; ``finished``: the result's arrays
-    (:func:`finished`)."""
-    reason, times, iters = grow_python(run, occ, job)
-    return reason, times, iters, finished(run)
-
-
-def finished(run: Tree) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """A finished run's path, segment lengths, trace iterations and costs
-    (:func:`vnrrt.planners.tree.finish`)."""
-    c, tree, trace = run.counters, run.tree, run.trace
-    return nodes.finish(tree.links, tree.pts, tree.cost, int(c.goal[0]), trace.iters,
-                        trace.costs, int(c.trace_len[0]), int(c.iters[0]))  # fmt: skip
-
-
-def grow_python(run: Tree, occ: np.ndarray, job: Job) -> tuple[str, np.ndarray, np.ndarray]:
-    """:func:`drive_python`'s loop: its first three returns."""
-    tree, _, c, trace = run.flat
-    stops, budget = job.stops, job.setup.work.budget
-    core.plant_flat(occ, tree, c, run.scratch.stack, trace, job.first, stops)
-    c = run.counters
-    times, iters = unreached(len(stops))
-    chunk, passed, status = FIRST_CHUNK, 0, core.RUNNING
-    draws, params_t = job.setup.draws, job.params
-    draws_t = job.setup.flat_draws
+    ``tree``, ``scratch``, ``counters``, ``trace`` (:attr:`Tree.flat`), ``draws`` and ``p``
+    (``first``: those of planting) are plain tuples (:class:`Draws`, :class:`Params`);
+    ``stops`` (M,) decreasing cost bounds; ``limits`` ``(target, max_iterations,
+    max_seconds, t0)`` (target ``inf``: the first solution; ``t0``: the run's start on the
+    clock, seconds); ``state`` (3,) int64 kept across calls: next chunk size, bounds passed,
+    plant first; ``times`` (M,) float64 and ``iters`` (M,) int64: when each bound was first
+    passed (NaN / -1: never). Returns ``(code, path, segs, trace_iters, trace_costs)``, the
+    code :data:`SOLVED`, :data:`MAX_ITERATIONS`, :data:`MAX_SECONDS` or
+    :data:`~vnrrt.planners.rrt_star.TREE_FULL` (the arrays then empty: the caller enlarges
+    the tree and calls again).
+    """
+    t, c, tr = nodes.Tree(*tree), nodes.Counters(*counters), nodes.Trace(*trace)
+    scratch, draws, p = nodes.Scratch(*scratch), Draws(*draws), Params(*p)
+    target, max_iterations, max_seconds, t0 = limits
+    if state[2]:
+        rrt_star.plant(occ, t, c, scratch.stack, tr, Params(*first), stops)
+        state[2] = 0
+    status = rrt_star.RUNNING
     while True:
-        now = time.perf_counter() - job.t0
-        for m in range(passed, int(c.milestone[0])):
-            times[m], iters[m] = now, int(c.iters[0])
-        passed = int(c.milestone[0])
-        if run.solved(job.target):
-            return "solved", times, iters
-        if status == core.TREE_FULL:
-            make_room(run, budget)
-        if c.iters[0] >= budget.max_iterations:
-            return "max_iterations", times, iters
-        if now >= budget.max_seconds:
-            return "max_seconds", times, iters
-        if core.gaps_due(draws, int(c.iters[0])) <= 0:
-            draws = core.with_gaps(occ, draws)
-            draws_t = tuple(draws)
-        due = core.gaps_due(draws, int(c.iters[0]))
-        n = min(chunk, budget.max_iterations - int(c.iters[0]), due)
-        status = core.grow_flat(occ, *run.flat, job.rng, draws_t, stops, params_t, n)
-        chunk = min(2 * chunk, MAX_CHUNK)
+        now = monotonic() - t0
+        for b in range(state[1], c.milestone[0]):
+            times[b], iters[b] = now, c.iters[0]
+        state[1] = c.milestone[0]
+        code = rrt_star.RUNNING
+        if c.goal[0] >= 0 and t.cost[c.goal[0]] <= target:
+            code = SOLVED
+        elif status == TREE_FULL:
+            return TREE_FULL, np.zeros((0, 2)), np.zeros(0), np.zeros(0, np.int64), np.zeros(0)
+        elif c.iters[0] >= max_iterations:
+            code = MAX_ITERATIONS
+        elif now >= max_seconds:
+            code = MAX_SECONDS
+        if code != rrt_star.RUNNING:
+            path, segs, trace_iters, trace_costs = nodes.finish(
+                t.links, t.pts, t.cost, c.goal[0], tr.iters, tr.costs, c.trace_len[0], c.iters[0]
+            )
+            return code, path, segs, trace_iters, trace_costs
+        if rrt_star.gaps_due(draws, c.iters[0]) <= 0:
+            draws = rrt_star.with_gaps(occ, draws)
+        n = min(state[0], max_iterations - c.iters[0], rrt_star.gaps_due(draws, c.iters[0]))
+        status = rrt_star.grow(occ, t, scratch, c, tr, rng, draws, stops, p, n)
+        state[0] = min(2 * state[0], MAX_CHUNK)
 
 
 def result(
-    run: Tree,
+    tree: Tree,
     planner: str,
     query: Query,
     *,
     reason: str,
     reached: dict[float, tuple[float, int]],
     elapsed: float,
-    finished: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray],
+    arrays: list,
 ) -> PlanResult:
     """The :class:`PlanResult` of a finished run; ``reached[bound] = (seconds, iteration)``;
-    ``finished``: its path, segment lengths, trace iterations and costs (:func:`finished`)."""
-    c, tree = run.counters, run.tree
+    ``arrays``: its path, segment lengths, trace iterations and costs (:func:`grow_tree`)."""
+    c, t = tree.counters, tree.tree
     n, g, k = int(c.nodes[0]), int(c.goal[0]), int(c.trace_len[0])
-    path, segs, trace_it, trace_cost = finished
-    first_time, first_iter = reached[math.inf]
-    return made({
-        "planner": planner,
-        "success": reason == "solved",
-        "stop_reason": reason,
-        "path": path,
-        "cost": float(np.add.reduce(segs)) if g >= 0 else math.inf,  # = polyline_length(path)
-        "iterations": int(c.iters[0]),
-        "tree_size": n,
-        "collision_checks": int(c.checks[0]),
-        "time_to_first": first_time,
-        "time_to_stop": elapsed,
-        "first_cost": float(trace_cost[0]) if k else math.inf,
-        "first_iteration": first_iter,
-        "trace_iterations": trace_it,
-        "trace_costs": trace_cost,
-        "reference_length": query.reference_length,
-        "target_cost": query.target,
-        "milestones": tuple(Milestone(b, *reached[b]) for b in query.bounds),
-        "fallback_uniform": query.fallback_uniform,
-        "setup_time": query.setup_time,
-        "tree_points": tree.pts[:n].copy() if query.keep_tree else None,
-        "tree_parents": tree.links[:n, nodes.PARENT].copy() if query.keep_tree else None,
-    })  # fmt: skip
+    path, segs, trace_iterations, trace_costs = arrays
+    first_time, first_iteration = reached[math.inf]
+    return PlanResult(
+        planner=planner,
+        success=reason == "solved",
+        stop_reason=reason,
+        path=path,
+        cost=float(np.add.reduce(segs)) if g >= 0 else math.inf,  # = polyline_length(path)
+        iterations=int(c.iters[0]),
+        tree_size=n,
+        collision_checks=int(c.checks[0]),
+        time_to_first=first_time,
+        time_to_stop=elapsed,
+        first_cost=float(trace_costs[0]) if k else math.inf,
+        first_iteration=first_iteration,
+        trace_iterations=trace_iterations,
+        trace_costs=trace_costs,
+        reference_length=query.reference_length,
+        target_cost=query.target,
+        milestones=tuple(Milestone(b, *reached[b]) for b in query.bounds),
+        fallback_uniform=query.fallback_uniform,
+        setup_time=query.setup_time,
+        tree_points=t.pts[:n].copy() if query.keep_tree else None,
+        tree_parents=t.links[:n, nodes.PARENT].copy() if query.keep_tree else None,
+    )
+
+
+def straight_result(planner: str, d: float, found: float, query: Query) -> PlanResult:
+    """The result of a run answered after ``found`` seconds by the free straight segment of
+    length ``d`` from start to goal: the tree is the root and the goal joined to it (one
+    segment test). The cost is ``d``, equal to the polyline length of the path (both are
+    libm's ``hypot``)."""
+    path = np.array((query.start, query.goal))
+    return PlanResult(
+        planner=planner,
+        success=True,
+        stop_reason="solved",
+        path=path,
+        cost=d,
+        iterations=0,
+        tree_size=2,
+        collision_checks=1,
+        time_to_first=found,
+        time_to_stop=found,
+        first_cost=d,
+        first_iteration=0,
+        trace_iterations=np.zeros(1, np.int64),
+        trace_costs=np.array((d,)),
+        reference_length=query.reference_length,
+        target_cost=query.target,
+        milestones=tuple(Milestone(b, found, 0) if d <= b else Milestone(b) for b in query.bounds),
+        fallback_uniform=query.fallback_uniform,
+        setup_time=query.setup_time,
+        tree_points=path.copy() if query.keep_tree else None,
+        tree_parents=np.array((-1, 0), np.int64) if query.keep_tree else None,
+    )

@@ -28,7 +28,6 @@ whose 4-word ``uint64`` state is seeded as :class:`numpy.random.SeedSequence` se
 
 from __future__ import annotations
 
-import functools
 import math
 from dataclasses import dataclass
 
@@ -93,13 +92,7 @@ class Sampler:
 
 def uniform_sampler(shape: tuple[int, int]) -> Sampler:
     """Uniform sampler over the ``(H, W)`` map."""
-    return _uniform(int(shape[0]), int(shape[1]))
-
-
-@functools.lru_cache(maxsize=64)
-def _uniform(h: int, w: int) -> Sampler:
-    """One uniform sampler per map shape (it holds no weights: nothing to change)."""
-    return Sampler("uniform", 0.0, np.zeros(0), -1, (h, w))
+    return Sampler("uniform", 0.0, np.zeros(0), -1, (int(shape[0]), int(shape[1])))
 
 
 def heatmap_sampler(

@@ -3,8 +3,9 @@
 import numpy as np
 import pytest
 
-from vnrrt.planners import core, path_free, point_free, segment_free
+from vnrrt.planners import path_free, point_free, segment_free
 from vnrrt.planners.collision import MARGIN
+from vnrrt.planners.rrt_star import straight_cost
 
 
 def touches_box(p0, p1, lo, hi) -> bool:
@@ -106,9 +107,9 @@ def test_path_free_checks_every_segment():
 
 @pytest.mark.parametrize("lattice", [False, True])
 def test_a_querys_compiled_checks_match_the_brute_force_reference(grid, lattice):
-    """core.query_test: BAD_ENDPOINT when either endpoint touches an obstacle or the border,
-    else the start-goal distance when the segment is free and -1 when it is blocked (or, with
-    ``straight`` False, -1 without testing it); checked against :func:`reference_free`."""
+    """A query's compiled checks: an endpoint's zero-length segment is not free when it
+    touches an obstacle or the border; straight_cost is the start-goal distance when the
+    segment is free and -1 when it is blocked; checked against :func:`reference_free`."""
     rng = np.random.default_rng(29 + lattice)
     h, w = grid.shape
     seen = set()
@@ -118,15 +119,16 @@ def test_a_querys_compiled_checks_match_the_brute_force_reference(grid, lattice)
             p = np.clip(np.round(p * 2) / 2, 0.5, [w - 0.5, h - 0.5, w - 0.5, h - 0.5])
         a, b = p[:2], p[2:]
         if not (reference_free(grid, a, a) and reference_free(grid, b, b)):
-            want = core.BAD_ENDPOINT
+            want = "bad"
         elif reference_free(grid, a, b):
             want = float(np.hypot(*(b - a)))
         else:
             want = -1.0
-        assert core.query_test(grid, *p, True) == pytest.approx(want, abs=1e-12), p
-        plain = core.query_test(grid, *p, False)
-        assert plain == (core.BAD_ENDPOINT if want == core.BAD_ENDPOINT else -1.0), p
-        seen.add("bad" if want == core.BAD_ENDPOINT else "blocked" if want < 0 else "free")
+        ends_free = segment_free(grid, *a, *a) and segment_free(grid, *b, *b)
+        assert ends_free is (want != "bad"), p
+        if want != "bad":
+            assert straight_cost(grid, *p) == pytest.approx(want, abs=1e-12), p
+        seen.add(want if want == "bad" else "blocked" if want < 0 else "free")
     assert seen == {"bad", "blocked", "free"}
 
 

@@ -1,28 +1,15 @@
-"""The run's loop in one compiled call (planners/loop.py) against its Python twin
-(run.drive_python), and the compiled clock against time.perf_counter."""
+"""One timed run (planners/run.py): its tree does not depend on where the compiled loop
+returns (chunk ends at the bounds passed, a tree enlarged when full, a planner's arrays
+reused), its times are ordered, and the time budget ends it."""
 
 import math
-import time
 
 import numpy as np
 import pytest
 
 from vnrrt.maps.named import named_map
-from vnrrt.planners import FASTEST, PlannerConfig, clock, plan, run
-from vnrrt.planners.api import warmup
-
-pytestmark = pytest.mark.skipif(not clock.IN_KERNEL, reason="the compiled clock is 64-bit Linux")
-
-
-def test_the_compiled_clock_is_perf_counters():
-    """monotonic() read between two perf_counter() reads lies between them (same clock)."""
-    clock.monotonic()
-    for _ in range(100):
-        a = time.perf_counter()
-        b = clock.monotonic()
-        c = time.perf_counter()
-        assert a <= b <= c
-
+from vnrrt.planners import FASTEST, Planner, PlannerConfig, plan, run
+from vnrrt.planners.planner import warmup
 
 CASES = [
     ("rrt_star", PlannerConfig(), "optimal", ()),
@@ -43,12 +30,11 @@ CASES = [
 
 
 @pytest.mark.parametrize(("planner", "config", "stop", "factors"), CASES)
-def test_the_compiled_loop_grows_the_same_tree_as_the_python_loop(
-    monkeypatch, planner, config, stop, factors
-):
-    """Same seed: the same iterations, nodes, checks, costs, path and trace from both loops
-    (the tree enlarged in between when it fills up); the compiled loop's times are ordered
-    (first solution, bounds passed, stop) and within the run."""
+def test_a_runs_tree_does_not_depend_on_where_its_loop_returns(planner, config, stop, factors):
+    """Same seed: the same iterations, nodes, checks, costs, path and trace whether the loop's
+    chunks end at extra cost bounds (milestones) or not, and whether the tree starts small
+    (enlarged when full) or in a planner's arrays already grown (as by an earlier run); the times
+    are ordered (first solution, bounds passed, stop) and within the run."""
     warmup()
     fm = named_map("cluttered", 200)
     s, g = fm.starts[0] + 0.5, fm.goals[0] + 0.5
@@ -56,20 +42,20 @@ def test_the_compiled_loop_grows_the_same_tree_as_the_python_loop(
     # the straight line at eps 0 (a turning map): a target no run meets, the budget ends it
     ref = math.dist(s, g) if stop == "unreachable" else None
     stop = "optimal" if stop == "unreachable" else stop
-    results = {}
-    for compiled in (True, False):
-        monkeypatch.setattr(clock, "IN_KERNEL", compiled)
-        r0 = plan(fm.grid, s, g, planner, heatmap=heat, config=config, stop=stop, seed=7,
-                  reference_length=ref)  # fmt: skip
-        bounds = tuple(f * r0.cost for f in factors)
-        results[compiled] = plan(fm.grid, s, g, planner, heatmap=heat, config=config, stop=stop,
-                                 seed=7, reference_length=ref, milestones=bounds)  # fmt: skip
-    a, b = results[True], results[False]
-    for field in ("success", "stop_reason", "cost", "iterations", "tree_size", "collision_checks",
-                  "first_cost", "first_iteration"):  # fmt: skip
-        assert getattr(a, field) == getattr(b, field), field
-    np.testing.assert_array_equal(a.path, b.path)
-    np.testing.assert_array_equal(a.trace_costs, b.trace_costs)
+    ask = {"stop": stop, "seed": 7, "reference_length": ref}
+    plain = plan(fm.grid, s, g, planner, heatmap=heat, config=config, **ask)
+    bounds = tuple(f * plain.cost for f in factors)
+    a = plan(fm.grid, s, g, planner, heatmap=heat, config=config, milestones=bounds, **ask)
+    grown = Planner(fm.grid, planner, heatmap=heat, config=config)
+    grown.setup.fresh().enlarge(config.max_iterations)  # as an earlier, longer run left them
+    b = grown.solve(s, g, milestones=bounds, **ask)
+    for r in (a, b):
+        for field in ("success", "stop_reason", "cost", "iterations", "tree_size",
+                      "collision_checks", "first_cost", "first_iteration"):  # fmt: skip
+            assert getattr(r, field) == getattr(plain, field), field
+        np.testing.assert_array_equal(r.path, plain.path)
+        np.testing.assert_array_equal(r.trace_costs, plain.trace_costs)
+        np.testing.assert_array_equal(r.trace_iterations, plain.trace_iterations)
     assert [m.iteration for m in a.milestones] == [m.iteration for m in b.milestones]
     times = [a.time_to_first, *(m.time for m in a.milestones if m.reached), a.time_to_stop]
     assert all(not math.isnan(t) for t in times) and times == sorted(times)

@@ -56,8 +56,8 @@ def test_same_seed_same_result_as_before_the_api_change(cluttered, planner, labe
 
 
 # (settings, stop) -> (cost, iterations, tree size, collision checks) of RRT* on the cluttered
-# map with seed (3, 1) and the exact optimum as the reference (267.2472961387225 px), recorded
-# with the code before plan()'s one-shot run without a Planner (commit 0ae509b)
+# map with seed (3, 1) and the exact optimum as the reference (267.2472961387225 px),
+# pinned with the code of commit 0ae509b
 FASTEST_PINNED = {
     ("fastest", "initial"): (286.1381321602575, 39, 22, 91),
     ("fastest", "optimal"): (269.4510754544849, 168, 59, 396),
@@ -70,9 +70,8 @@ FASTEST_PINNED = {
 
 @pytest.mark.parametrize(("label", "stop"), list(FASTEST_PINNED))
 def test_a_one_shot_plan_and_a_planners_solve_give_the_results_before(cluttered, label, stop):
-    """plan()'s common form (its segment tested in C, the run without a Planner) and a
-    Planner's solve() reproduce the pinned results, with our fastest settings, a fixed radius
-    and a given gamma."""
+    """plan() and a Planner's solve() reproduce the pinned results, with our fastest
+    settings, a fixed radius and a given gamma."""
     from vnrrt.planners import FASTEST, Planner
 
     grid, start, goal = cluttered

@@ -13,10 +13,10 @@ from vnrrt.planners import (
     PlannerConfig,
     PlannerConfigError,
     any_angle_path,
-    core,
     path_free,
     plan,
     refine,
+    rrt_star,
     spatial,
 )
 from vnrrt.planners import tree as nodes
@@ -48,10 +48,10 @@ def chain(points, goal_last=True):
     return t, c
 
 
-def params(**over) -> core.Params:
+def params(**over) -> rrt_star.Params:
     base = dict(eta=10.0, gamma=0.0, radius=5.0, goal_radius=10.0, sx=5.5, sy=30.5, gx=34.5,
                 gy=30.5, min_spacing=0.0, bucket=5.0, informed=True, refine=1.0)  # fmt: skip
-    return core.Params(**{**base, **over})
+    return rrt_star.Params(**{**base, **over})
 
 
 def branch_costs(t, n):
@@ -75,9 +75,9 @@ def test_pull_up_takes_the_furthest_ancestor_that_sees_the_node():
     t, c = chain(pts, goal_last=False)
     x, y = 30.5, 9.0  # seen from (15.5, 8.5) and (19.5, 8.5); (10.5, 12.5) is behind the wall
     assert not segment_free(g, 10.5, 12.5, x, y) and segment_free(g, 15.5, 8.5, x, y)
-    q, cost = core.pull_up(g, t, c, 4, t.cost[4] + math.dist(pts[4], (x, y)), x, y)
+    q, cost = rrt_star.pull_up(g, t, c, 4, t.cost[4] + math.dist(pts[4], (x, y)), x, y)
     assert q == 2 and cost == pytest.approx(t.cost[2] + math.dist(pts[2], (x, y)))
-    q, _ = core.pull_up(g, t, c, 0, 1.0, x, y)  # the root has no parent: it stays
+    q, _ = rrt_star.pull_up(g, t, c, 0, 1.0, x, y)  # the root has no parent: it stays
     assert q == 0
 
 

@@ -17,16 +17,15 @@ from vnrrt.maps.named import named_map
 from vnrrt.planners import (
     PlannerConfig,
     any_angle_path,
-    core,
     draw,
     heatmap_sampler,
     path_free,
     plan,
-    run,
+    rrt_star,
     uniform_sampler,
 )
 from vnrrt.planners import tree as nodes
-from vnrrt.planners.api import warmup
+from vnrrt.planners.planner import warmup
 from vnrrt.planners.run import FIRST_CAPACITY
 from vnrrt.planners.samplers import HEATMAP_TRIES, rng_state
 
@@ -90,17 +89,17 @@ def test_heatmap_draws_without_mass_in_the_ellipse_fall_back_to_uniform_there():
 
 
 def test_the_core_samples_in_the_ellipse_once_a_solution_exists_and_only_when_informed():
-    """:func:`vnrrt.planners.core.sample` (what every planner's iteration draws): inside the
+    """:func:`vnrrt.planners.rrt_star.sample` (what every planner's iteration draws): inside the
     ellipse of ``c_best`` when informed and solved, over the whole map otherwise."""
     h, w, s, g, c_best = 100, 100, (20.5, 30.5), (60.5, 40.5), 50.0
     sampler = heatmap_sampler(np.random.default_rng(0).random((h, w)), (h, w), mix=0.5)
-    draws = core.Draws(sampler.mix, sampler.cdf, sampler.last)
-    p = core.Params(eta=10.0, gamma=0.0, radius=5.0, goal_radius=10.0, sx=s[0], sy=s[1],
+    draws = rrt_star.Draws(sampler.mix, sampler.cdf, sampler.last)
+    p = rrt_star.Params(eta=10.0, gamma=0.0, radius=5.0, goal_radius=10.0, sx=s[0], sy=s[1],
                     gx=g[0], gy=g[1], min_spacing=0.0, bucket=5.0, informed=True)  # fmt: skip
 
     def points(params, cost):
         rng = rng_state(7)
-        return np.array([core.sample(rng, h, w, draws, params, cost) for _ in range(4000)])
+        return np.array([rrt_star.sample(rng, h, w, draws, params, cost) for _ in range(4000)])
 
     assert inside(points(p, c_best), np.array(s), np.array(g), c_best).all()
     for params, cost in ((p, math.inf), (p._replace(informed=False), c_best)):
@@ -232,7 +231,6 @@ def test_tree_memory_follows_the_work_done_not_the_budget(monkeypatch):
     even with a budget of a billion iterations; a longer run doubles the room when full,
     up to the budget (+ root and goal)."""
     warmup()  # its own small runs first
-    run.POOL.clear()  # no tree of an earlier plan() to reuse
     sizes = []
     new_tree, enlarge = nodes.new_tree, nodes.enlarge
     monkeypatch.setattr(nodes, "new_tree", lambda c, *a: sizes.append(c) or new_tree(c, *a))
@@ -242,7 +240,6 @@ def test_tree_memory_follows_the_work_done_not_the_budget(monkeypatch):
     r = plan(fm.grid, s, g, config=PlannerConfig(max_iterations=10**9), seed=0)
     assert r.success and sizes == [FIRST_CAPACITY] and r.tree_size < FIRST_CAPACITY
     sizes.clear()
-    run.POOL.clear()
     r = plan(fm.grid, s, g, stop="optimal", reference_length=math.dist(s, g),
              config=PlannerConfig(max_iterations=10_000, eps=0.0))  # fmt: skip
     assert r.stop_reason == "max_iterations" and r.iterations == 10_000

@@ -7,8 +7,8 @@ import shutil
 
 import numpy as np
 import pytest
-from benchmarks import ompl_native
 
+from benchmarks import ompl_native
 from vnrrt.maps.named import named_map
 from vnrrt.planners import any_angle_path, polyline_length
 

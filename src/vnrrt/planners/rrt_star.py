@@ -1,4 +1,4 @@
-"""The one RRT* core (paper, Algorithm 1 / Algorithm 2), compiled with numba.
+"""RRT*: the one core of every planner (paper, Algorithm 1 / Algorithm 2), compiled with numba.
 
 All planners (RRT*, NRRT*, VNRRT*, M-VNRRT*, and their informed variants) run :func:`grow`;
 they differ only in the :class:`Draws` (the sampler) and :class:`Params` passed in and in
@@ -36,19 +36,15 @@ import math
 from typing import NamedTuple
 
 import numpy as np
-from numba import carray, njit
+from numba import njit
 
 from vnrrt.planners import spatial
-from vnrrt.planners.collision import points_free, segment_free
+from vnrrt.planners.collision import segment_free
 from vnrrt.planners.gaps import gap_cells
 from vnrrt.planners.refine import AT_REST, IMPROVED, refine_step
 from vnrrt.planners.samplers import NO_CELLS, any_point, next_double
 from vnrrt.planners.tree import (
     PARENT,
-    Counters,
-    Scratch,
-    Trace,
-    Tree,
     add_node,
     best_cost,
     record,
@@ -210,29 +206,6 @@ def straight_cost(occ, sx, sy, gx, gy):
     return 0.0 + math.hypot(gx - sx, gy - sy)
 
 
-BAD_ENDPOINT = -2.0  # :func:`query_test`: start or goal touches an obstacle or the border
-
-
-@njit(cache=True)
-def query_test(occ, sx, sy, gx, gy, straight):
-    """A query's checks in one compiled call: :data:`BAD_ENDPOINT` when start or goal
-    touches an obstacle cell or the map border (:func:`~.collision.points_free`); else,
-    with ``straight``, :func:`straight_cost` (the distance, -1 when blocked); else -1."""
-    if not points_free(occ, sx, sy, gx, gy):
-        return BAD_ENDPOINT
-    if not straight:
-        return -1.0
-    return straight_cost(occ, sx, sy, gx, gy)
-
-
-def query_test_at(ptr, h, w, sx, sy, gx, gy):
-    """:func:`query_test` with the straight segment tested, on the ``(h, w)`` C-order uint8
-    grid at address ``ptr``: compiled as a C function by :func:`vnrrt.planners.native.answerer`
-    (at first use, not at import), defined here so that numba's cache of it goes with this
-    file (and, like every kernel's, not with its callees': ``make clean``)."""
-    return query_test(carray(ptr, (h, w)), sx, sy, gx, gy, True)
-
-
 @njit(cache=True)
 def plant(occ, tree, counters, stack, trace, p, milestones):
     """The root at the start, the goal joined to it when ``p`` allows (:func:`connect_goal`)
@@ -317,17 +290,3 @@ def grow(occ, tree, scratch, counters, trace, rng, draws, milestones, p, n_iter)
         if record(counters, tree, trace, milestones):
             return MILESTONE_HIT
     return RUNNING
-
-
-@njit(cache=True)
-def plant_flat(occ, tree, counters, stack, trace, p, milestones):
-    """:func:`plant` on plain tuples in place of the named ones (see :func:`grow_flat`)."""
-    plant(occ, Tree(*tree), Counters(*counters), stack, Trace(*trace), Params(*p), milestones)
-
-
-@njit(cache=True)
-def grow_flat(occ, tree, scratch, counters, trace, rng, draws, milestones, p, n_iter):
-    """:func:`grow` on plain tuples in place of the named ones: numba types a call's plain
-    tuples of arrays about 3x faster than named tuples (~5 us instead of ~16 us a call)."""
-    return grow(occ, Tree(*tree), Scratch(*scratch), Counters(*counters), Trace(*trace), rng,
-                Draws(*draws), milestones, Params(*p), n_iter)  # fmt: skip
