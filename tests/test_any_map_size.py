@@ -17,7 +17,7 @@ from vnrrt.grid import GridError
 from vnrrt.maps.generate import FloorMap
 from vnrrt.maps.movingai import read_map, read_scen
 from vnrrt.planners import FASTEST, PlannerConfig, plan
-from vnrrt.planners.settings import gamma
+from vnrrt.planners.run import gamma
 from vnrrt.search import any_angle_length, any_angle_path, astar, segment_visible
 
 MAP = REPO / "data" / "movingai" / "lak304d.map"

@@ -58,6 +58,12 @@ def test_the_wheel_installs_and_answers_outside_the_repository(installed, repo):
     out = subprocess.run([py, "-m", "vnrrt", "plan", "--help"], cwd=work, capture_output=True,
                          text=True, check=True).stdout  # fmt: skip
     assert "--map" in out and "--stop" in out
+    # the library's defaults and the composition read the conf/ packaged in the wheel
+    code = ("import vnrrt.config as c, vnrrt.maps.config as m, vnrrt.planners as p; "
+            "m.DataConfig(); c.compose([]); print(c.CONF_DIR, p.FASTEST.informed)")  # fmt: skip
+    out = subprocess.run([py, "-c", code], cwd=work, capture_output=True, text=True,
+                         check=True).stdout  # fmt: skip
+    assert out.startswith(purelib) and out.strip().endswith("True")
 
 
 @pytest.mark.slow

@@ -24,7 +24,13 @@ if TYPE_CHECKING:
     from omegaconf import DictConfig
 
 REPO_ROOT = Path(__file__).resolve().parents[3]
-CONF_DIR = Path(os.environ.get("VNRRT_CONF_DIR", REPO_ROOT / "conf"))
+# conf/ of the repository; in an installed wheel its copy (package data: src/vnrrt/conf links
+# to it); VNRRT_CONF_DIR names another
+_PACKAGED = Path(__file__).resolve().parents[1] / "conf"
+CONF_DIR = Path(
+    os.environ.get("VNRRT_CONF_DIR")
+    or (REPO_ROOT / "conf" if (REPO_ROOT / "conf").is_dir() else _PACKAGED)
+)
 
 T = TypeVar("T")
 

@@ -2,8 +2,8 @@
 (read here, written nowhere else), and :data:`FASTEST`, ``conf/planner/fastest.yaml`` (the
 Hydra option ``planner=fastest``). Lengths in pixels, times in seconds.
 
-The files are read from :data:`CONF_DIR`, ``vnrrt/planners/conf``: in the repository a link
-to ``conf/planner``, in an installed wheel its copy (package data). Kept free of
+The files are read from :data:`CONF_DIR`, ``conf/planner`` of :data:`vnrrt.config.CONF_DIR`
+(the repository's ``conf/``, in an installed wheel its packaged copy). Kept free of
 Hydra/OmegaConf (the files are read with PyYAML) so that :mod:`vnrrt.planners` depends only
 on :mod:`vnrrt.grid` and :mod:`vnrrt.search`; ``vnrrt.config.section(cfg, "planner",
 PlannerConfig)`` validates the composed YAML against this dataclass.
@@ -14,15 +14,15 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import yaml
 
+from vnrrt import config
 from vnrrt.names import PLANNERS  # noqa: F401  (re-exported: the one list of planners)
 
 REFERENCES = ("astar", "any_angle", "taut")
 RADIUS_MODES = ("shrinking", "fixed")
-CONF_DIR = Path(__file__).parent / "conf"  # conf/planner (a link to it, or its packaged copy)
+CONF_DIR = config.CONF_DIR / "planner"
 
 
 def load(name: str) -> dict:
