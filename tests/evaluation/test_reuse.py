@@ -139,3 +139,23 @@ def test_the_digest_tells_values_types_and_shapes_apart():
     assert reuse.digest(1) != reuse.digest(1.0) != reuse.digest(True)
     assert reuse.digest({"a": 1}) == reuse.digest({"a": 1}) != reuse.digest({"a": 2})
     assert reuse.digest(0.1 + 0.2) != reuse.digest(0.3)
+
+
+def test_a_configurations_jobs_keep_their_parts_when_others_come_or_go():
+    """Parts by what a job runs (protocol.part_of), not by its place in the list: an ablation
+    that adds M-VNRRT* at tau 0.7 leaves every other configuration's jobs in their parts (so
+    their kept rows fit again); the parts still partition the jobs, in similar sizes."""
+    from vnrrt.evaluation.protocol import part_jobs
+
+    kinds = ["random"] * 40
+    counts = {("random", "initial"): 1, ("random", "optimal"): 2}
+    before = trial_jobs(kinds, [RRT, NRRT, mvn(0.5), mvn(0.9)], counts)
+    after = trial_jobs(kinds, [RRT, NRRT, mvn(0.5), mvn(0.7), mvn(0.9)], counts)
+
+    def part(jobs, k):
+        return {(j.key.text, j.instance, j.stop, j.first) for j in part_jobs(jobs, k, 3)}
+
+    for k in range(3):
+        assert {x for x in part(after, k) if x[0] != "m_vnrrt_star@0.7"} == part(before, k)
+    sizes = [len(part(after, k)) for k in range(3)]
+    assert sum(sizes) == len(after) and min(sizes) > 0.7 * max(sizes)

@@ -20,6 +20,7 @@ Nothing here plans or reads files; :mod:`vnrrt.evaluation.trials` runs the jobs,
 
 from __future__ import annotations
 
+import zlib
 from dataclasses import dataclass
 
 import numpy as np
@@ -143,8 +144,18 @@ def trial_jobs(
 
 
 def part_jobs(jobs: list[TrialJob], part: int, parts: int) -> list[TrialJob]:
-    """The jobs of part ``part`` of ``parts``: every ``parts``-th job (round robin, so each
-    part gets a similar mix of instances, configurations and stop rules)."""
+    """The jobs of part ``part`` of ``parts``, in their order: those :func:`part_of` assigns
+    to it (a hash, so each part gets a similar mix of instances, configurations and stop
+    rules)."""
     if not 0 <= part < parts:
         raise ConfigError(f"part {part} is not in 0..{parts - 1}")
-    return jobs[part::parts]
+    return [job for job in jobs if part_of(job, parts) == part]
+
+
+def part_of(job: TrialJob, parts: int) -> int:
+    """The part of ``job`` among ``parts``: a hash of what the job runs (instance,
+    configuration key, stop rule, first trial, regime cell), not of its place in the job
+    list, so that a configuration's jobs keep their parts when an ablation adds or removes
+    other configurations (and its kept rows are reused: :mod:`vnrrt.evaluation.reuse`)."""
+    what = f"{job.instance}|{job.key.text}|{job.stop}|{job.first}|{job.regime}"
+    return zlib.crc32(what.encode()) % parts
