@@ -29,6 +29,13 @@ def group_alive(pgid: int) -> list[int]:
     return alive
 
 
+def sigint_default() -> None:
+    """In the child before it runs: SIGINT at its default, as in a terminal. A test run
+    started in the background (``make test &``) inherits SIGINT ignored, and Python then keeps
+    it ignored, so the Ctrl-C these tests send would not reach the stage at all."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 @pytest.mark.parametrize(
     ("sig", "target"),
     [(signal.SIGINT, "group"), (signal.SIGINT, "parent"), (signal.SIGTERM, "parent")],
@@ -43,7 +50,7 @@ def test_a_signal_ends_a_shard_stage_within_seconds_and_leaves_nothing(tmp_path,
     env = dict(os.environ, PYTHONUNBUFFERED="1")
     proc = subprocess.Popen([sys.executable, "stages/shard.py", "--shard", "0"], cwd=work,
                             env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                            start_new_session=True)  # fmt: skip
+                            start_new_session=True, preexec_fn=sigint_default)  # fmt: skip
     time.sleep(4.0)  # the pool is up and working (3,000 maps take far longer)
     assert proc.poll() is None, proc.stdout.read().decode()
     workers = [p for p in group_alive(proc.pid) if p != proc.pid]
@@ -96,7 +103,8 @@ def test_a_signal_while_the_workers_start_leaves_no_worker_behind(tmp_path, sig,
     script = tmp_path / "slow_start.py"
     script.write_text(SLOW_START)
     proc = subprocess.Popen([sys.executable, str(script)], stdout=subprocess.PIPE,
-                            stderr=subprocess.STDOUT, start_new_session=True)  # fmt: skip
+                            stderr=subprocess.STDOUT, start_new_session=True,
+                            preexec_fn=sigint_default)  # fmt: skip
     assert proc.stdout.readline().strip() == b"forked"  # the signal lands inside slow_start
     (os.killpg if target == "group" else os.kill)(proc.pid, sig)
     try:
