@@ -74,8 +74,10 @@ def test_an_unreadable_file_is_named(tmp_path, monkeypatch):
     (tmp_path / "g").mkdir()
     (tmp_path / "g" / "default.yaml").write_text("a: [1\n")
     monkeypatch.setattr("vnrrt.config.CONF_DIR", tmp_path)
-    with pytest.raises(ConfigError, match="default.yaml cannot be read"):
+    with pytest.raises(ConfigError, match="default.yaml is not valid YAML"):
         conf_file("g")
+    with pytest.raises(ConfigError, match="missing.yaml does not exist"):
+        conf_file("g", "missing")
     with pytest.raises(ConfigError, match="no mapping under 'x'"):
         (tmp_path / "g" / "ok.yaml").write_text("a: 1\n")
         conf_file("g", "ok", node="x")

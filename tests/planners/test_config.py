@@ -8,15 +8,8 @@ import math
 import pytest
 import yaml
 
-from vnrrt.config import CONF_DIR, compose, section
+from vnrrt.config import CONF_DIR, compose, conf_defaults, conf_file, section
 from vnrrt.planners import FASTEST, PlannerConfig, PlannerConfigError
-from vnrrt.planners import config as planner_config
-
-
-def test_the_settings_files_read_are_the_pipelines():
-    """The planner's settings files (vnrrt/planners/conf) are conf/planner's, which Hydra
-    composes: the same files, not copies."""
-    assert planner_config.CONF_DIR.resolve() == (CONF_DIR / "planner").resolve()
 
 
 def test_the_defaults_are_the_default_yaml():
@@ -50,14 +43,16 @@ def test_fastest_is_the_hydra_option_planner_fastest():
 
 
 def test_a_yaml_file_that_does_not_match_the_dataclass_is_refused(tmp_path, monkeypatch):
-    (tmp_path / "base.yaml").write_text("eta: 3.0\nmix: 0.5\n")
-    (tmp_path / "over.yaml").write_text("defaults:\n  - base\n  - _self_\neta: 4.0\n")
-    (tmp_path / "first.yaml").write_text("defaults:\n  - _self_\n  - base\neta: 4.0\n")
-    monkeypatch.setattr(planner_config, "CONF_DIR", tmp_path)
-    assert planner_config.load("over") == {"eta": 4.0, "mix": 0.5}
-    assert planner_config.load("first") == {"eta": 3.0, "mix": 0.5}  # _self_ first
+    (tmp_path / "planner").mkdir()
+    (tmp_path / "planner" / "base.yaml").write_text("eta: 3.0\nmix: 0.5\n")
+    (tmp_path / "planner" / "over.yaml").write_text("defaults:\n  - base\n  - _self_\neta: 4.0\n")
+    (tmp_path / "planner" / "first.yaml").write_text("defaults:\n  - _self_\n  - base\neta: 4.0\n")
+    monkeypatch.setattr("vnrrt.config.CONF_DIR", tmp_path)
+    assert conf_file("planner", "over") == {"eta": 4.0, "mix": 0.5}
+    assert conf_file("planner", "first") == {"eta": 3.0, "mix": 0.5}  # _self_ first
+    only_eta = type("C", (), {"__annotations__": {"eta": "float"}})
     with pytest.raises(PlannerConfigError, match="differ"):
-        planner_config._defaults_from("base")(type("C", (), {"__annotations__": {"eta": "float"}}))
+        conf_defaults("planner", "base", exact=True, error=PlannerConfigError)(only_eta)
 
 
 def test_an_invalid_setting_is_named():

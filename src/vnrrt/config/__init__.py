@@ -40,36 +40,47 @@ class ConfigError(ValueError):
 
 
 def conf_file(group: str, option: str = "default", node: str | None = None) -> dict:
-    """The keys of ``conf/<group>/<option>.yaml`` (under its top-level ``node`` where given,
-    e.g. ``scale`` in a ``# @package _global_`` file) as plain Python values; YAML's
-    ``.inf`` is ``math.inf``, ``null`` is None. :class:`ConfigError` names a missing or
-    malformed file."""
-    import yaml
+    """The settings of ``conf/<group>/<option>.yaml`` as plain Python values (YAML's ``.inf``
+    is ``math.inf``, ``null`` is None), composed as Hydra composes a group option: the
+    options its ``defaults`` list names first, then its own keys (``_self_``, last when not
+    listed). With ``node``, the mapping under that top-level key (``scale`` in a ``# @package
+    _global_`` file), not composed. :class:`ConfigError` names a missing or malformed file."""
+    from vnrrt.infra.io import read_yaml
 
     path = CONF_DIR / group / f"{option}.yaml"
-    try:
-        doc = yaml.safe_load(path.read_text())
-    except (OSError, yaml.YAMLError) as err:
-        raise ConfigError(f"config file {path} cannot be read: {err}") from None
+    doc = read_yaml(path, "config file", ConfigError)
     if node is not None:
         doc = doc.get(node) if isinstance(doc, dict) else None
     if not isinstance(doc, dict):
         raise ConfigError(f"config file {path} has no mapping{f' under {node!r}' if node else ''}")
-    return doc
+    if node is not None:
+        return doc
+    bases = doc.pop("defaults", [])
+    if not all(isinstance(b, str) for b in bases):
+        raise ConfigError(f"config file {path}: its defaults name other groups' options")
+    merged: dict = {}
+    for base in bases if "_self_" in bases else [*bases, "_self_"]:
+        merged.update(doc if base == "_self_" else conf_file(group, base))
+    return merged
 
 
-def conf_defaults(group: str, option: str = "default", node: str | None = None):
+def conf_defaults(group: str, option: str = "default", node: str | None = None, *,
+                  exact: bool = False, error: type[Exception] = ConfigError):  # fmt: skip
     """Class decorator, applied below ``@dataclass``: the defaults of the class's own fields
     are the values of ``conf/<group>/<option>.yaml`` (:func:`conf_file`), so the library's
-    defaults and the pipeline's are one source. Every own field must be in the file
-    (:class:`ConfigError` otherwise); the file may hold more keys (a section's subset)."""
+    defaults and the pipeline's are one source. Every own field must be in the file; with
+    ``exact``, the file holds no other key (else it may: a section's subset). ``error``
+    (:class:`ConfigError` by default) names the file and the keys otherwise."""
 
     def wrap(cls: type[T]) -> type[T]:
         values = conf_file(group, option, node)
         names = list(inspect.get_annotations(cls))
         missing = [n for n in names if n not in values]
         if missing:
-            raise ConfigError(f"conf/{group}/{option}.yaml lacks {missing} ({cls.__name__})")
+            raise error(f"conf/{group}/{option}.yaml lacks {missing} ({cls.__name__})")
+        extra = sorted(set(values) - set(names)) if exact else []
+        if extra:
+            raise error(f"conf/{group}/{option}.yaml and {cls.__name__} differ: {extra}")
         for name in names:
             value = values[name]
             if isinstance(value, list | dict):

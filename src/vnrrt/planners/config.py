@@ -2,66 +2,34 @@
 (read here, written nowhere else), and :data:`FASTEST`, ``conf/planner/fastest.yaml`` (the
 Hydra option ``planner=fastest``). Lengths in pixels, times in seconds.
 
-The files are read from :data:`CONF_DIR`, ``conf/planner`` of :data:`vnrrt.config.CONF_DIR`
-(the repository's ``conf/``, in an installed wheel its packaged copy). Kept free of
+The files are read by :func:`vnrrt.config.conf_defaults` and :func:`vnrrt.config.conf_file`
+from ``conf/planner`` of :data:`vnrrt.config.CONF_DIR` (the repository's ``conf/``, in an
+installed wheel its packaged copy), as every typed section's defaults are. Kept free of
 Hydra/OmegaConf (the files are read with PyYAML) so that :mod:`vnrrt.planners` depends only
-on :mod:`vnrrt.grid` and :mod:`vnrrt.search`; ``vnrrt.config.section(cfg, "planner",
-PlannerConfig)`` validates the composed YAML against this dataclass.
+on :mod:`vnrrt.grid`, :mod:`vnrrt.search` and the readers of :mod:`vnrrt.config`;
+``vnrrt.config.section(cfg, "planner", PlannerConfig)`` validates the composed YAML against
+this dataclass.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import math
-from dataclasses import dataclass, field
-
-import yaml
+from dataclasses import dataclass
 
 from vnrrt import config
 from vnrrt.names import PLANNERS  # noqa: F401  (re-exported: the one list of planners)
 
 REFERENCES = ("astar", "any_angle", "taut")
 RADIUS_MODES = ("shrinking", "fixed")
-CONF_DIR = config.CONF_DIR / "planner"
-
-
-def load(name: str) -> dict:
-    """The settings of ``conf/planner/<name>.yaml`` as a dict, composed as Hydra composes a
-    group option: the options named in its ``defaults`` list first, then its own keys
-    (``_self_``, last when not listed)."""
-    path = CONF_DIR / f"{name}.yaml"
-    with open(path, encoding="utf-8") as f:
-        node = yaml.safe_load(f) or {}
-    bases = list(node.pop("defaults", []))
-    merged = {}
-    for base in bases if "_self_" in bases else [*bases, "_self_"]:
-        merged.update(node if base == "_self_" else load(base))
-    return merged
-
-
-def _defaults_from(name: str):
-    """A frozen dataclass whose field defaults are the settings of ``conf/planner/<name>.yaml``
-    (:func:`load`); the file must give every field and no other key."""
-
-    def build(cls):
-        values = load(name)
-        names = set(cls.__annotations__)
-        if set(values) != names:
-            wrong = sorted(names ^ set(values))
-            raise PlannerConfigError(f"conf/planner/{name}.yaml and PlannerConfig differ: {wrong}")
-        for key, value in values.items():
-            kept = value if not isinstance(value, list) else field(default_factory=value.copy)
-            setattr(cls, key, kept)
-        return dataclass(frozen=True)(cls)
-
-    return build
 
 
 class PlannerConfigError(ValueError):
     """A planner setting is invalid; the message names it."""
 
 
-@_defaults_from("default")
+@dataclass(frozen=True)
+@config.conf_defaults("planner", exact=True, error=PlannerConfigError)
 class PlannerConfig:
     """RRT* core, samplers, stop rules and budgets (paper, Background and VertexNet RRT*).
 
@@ -214,4 +182,6 @@ def _finite(v) -> bool:
     return isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)
 
 
-FASTEST = PlannerConfig(**load("fastest"))  # our fastest settings, any planner
+FASTEST = PlannerConfig(
+    **config.conf_file("planner", "fastest")
+)  # our fastest settings, any planner
