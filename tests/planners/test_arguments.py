@@ -35,6 +35,13 @@ def test_a_reference_that_is_not_a_number_is_a_type_error_naming_it(call, ref, s
 
 
 @pytest.mark.parametrize("call", list(_calls()), ids=["plan", "solve"])
+@pytest.mark.parametrize("ref", [-1.0, math.inf, math.nan])
+def test_an_initial_runs_recorded_reference_must_be_a_finite_length(call, ref):
+    with pytest.raises(ValueError, match="reference_length must be finite and >= 0"):
+        call(stop="initial", reference_length=ref, seed=1)
+
+
+@pytest.mark.parametrize("call", list(_calls()), ids=["plan", "solve"])
 def test_a_reachable_reference_still_plans(call):
     eps = PlannerConfig().eps
     for ref in (STRAIGHT, np.float32(STRAIGHT * 1.5), 14):  # the straight line: reachable

@@ -20,7 +20,8 @@ def check_stop_target(stop, reference_length, start, goal, config=None) -> None:
     reference_length`` (``config.eps``; None: :class:`PlannerConfig`'s) is at least the
     straight-line distance from ``start`` to ``goal`` (continuous ``(x, y)`` pixels;
     ``ValueError``): the cost of any path is at least that distance, so a lower bound could
-    never be met. Points that are not two numbers each, and a ``config`` that is not a
+    never be met; for any other stop (the reference is only recorded), a finite length
+    >= 0. Points that are not two numbers each, and a ``config`` that is not a
     :class:`PlannerConfig`, are left to their own checks."""
     if reference_length is None:
         return
@@ -34,9 +35,11 @@ def check_stop_target(stop, reference_length, start, goal, config=None) -> None:
             f"reference_length must be a number (pixels) or None, got "
             f"{type(reference_length).__name__} {reference_length!r}"
         )
-    if stop != "optimal":
-        return  # recorded in the result only (stop 'initial'); the stop rule is checked later
     ref = float(reference_length)
+    if stop != "optimal":  # recorded in the result only (stop 'initial')
+        if not (math.isfinite(ref) and ref >= 0):
+            raise ValueError(f"reference_length must be finite and >= 0, got {ref!r}")
+        return
     if not (math.isfinite(ref) and ref > 0):
         raise ValueError(
             f"reference_length must be a finite length > 0 for stop='optimal', got {ref!r}"

@@ -218,10 +218,6 @@ class Planner:
         _check_seed(seed)
         if reference_length is None and stop == "optimal":
             reference_length = compute_reference(self.occ, start, goal, self.config.reference)
-        if reference_length is not None and not (
-            math.isfinite(reference_length) and reference_length >= 0
-        ):
-            raise ValueError(f"reference_length must be finite and >= 0, got {reference_length}")
         target = None if stop == "initial" else (1.0 + self.config.eps) * reference_length
         bounds = tuple(float(m) for m in milestones)
         return run.Query(start, goal, target, bounds, keep_tree, reference_length,
