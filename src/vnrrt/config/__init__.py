@@ -185,9 +185,9 @@ def load_params(path: str | Path = "params.yaml") -> DictConfig:
 def sections_of_composition() -> list[str]:
     """The top-level keys every composition of ``conf/config.yaml`` has: its own keys and one
     section per config group of its defaults list (``hydra`` aside)."""
-    import yaml
+    from vnrrt.infra.io import read_yaml
 
-    root = yaml.safe_load((CONF_DIR / "config.yaml").read_text())
+    root = read_yaml(CONF_DIR / "config.yaml", "config file", ConfigError)
     groups = [next(iter(d)) for d in root.get("defaults", []) if isinstance(d, dict)]
     own = [k for k in root if k != "defaults"]
     return [k for k in dict.fromkeys(own + groups) if k != "hydra"]
