@@ -33,6 +33,7 @@ from vnrrt.data.config import LabelsConfig
 from vnrrt.data.heatmaps import read_heatmaps
 from vnrrt.data.manifest import verify_manifest
 from vnrrt.data.shards import shard_file
+from vnrrt.evaluation.noise import baseline_record
 from vnrrt.evaluation.table import SEEDED_COLUMNS, merge_parts
 from vnrrt.maps.config import DataConfig
 
@@ -558,6 +559,10 @@ def test_a_tau_ablation_reruns_only_m_vnrrt_and_moves_no_other_verdict(workdir):
     run(["git", "-c", "user.name=t", "-c", "user.email=t@t", "commit", "--allow-empty", "-qm",
          "before the tau ablation"], workdir)  # fmt: skip
     before, verdicts = _rows_by_trial(workdir), _verdicts(workdir)
+    summary = json.loads((workdir / "data/smoke/summary.json").read_text())
+    baseline = workdir / yaml.safe_load((workdir / "params.yaml").read_text())["paths"]["baseline"]
+    # the session's run stands for the default run (which keeps its claims there itself)
+    baseline.write_text(json.dumps(baseline_record(summary["claims"]["rows"])))
     ablation = ("planner.eps=0.05", "stats.level=0.9", "planner.taus=[0.3,0.5,0.7]",
                 "planner.tau=0.7")  # fmt: skip
     sets = [x for o in ("scale=smoke", seed_override(workdir), *ablation) for x in ("-S", o)]
@@ -575,6 +580,16 @@ def test_a_tau_ablation_reruns_only_m_vnrrt_and_moves_no_other_verdict(workdir):
     for claim, verdict in verdicts.items():
         if "m_vnrrt_star" not in claim:
             assert now[claim] == verdict, claim
+    # the report reads the machine's noise and sets each claim beside the default run's
+    report = (workdir / "reports/paper_comparison.md").read_text()
+    assert "## The machine's timing noise" in report and "### Against your default run" in report
+    section = report.split("### Against your default run")[1].split("\n## ")[0]
+    rows = [
+        line
+        for line in section.splitlines()
+        if line.startswith("| ") and "M-VNRRT*" not in line and "claim |" not in line
+    ]
+    assert rows and all("| +0.0% |" in r and "identical: re-timing only" in r for r in rows)
 
 
 ABLATION = {  # every reader-visible setting changed at once from the session's (one experiment)

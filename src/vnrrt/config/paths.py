@@ -34,6 +34,7 @@ class Paths:
     trials: str
     trials_table: str
     reuse: str
+    baseline: str  # the default run's claims (stage report; an ablation compares)
     summary: str
     oracle: str
     regime: str

@@ -70,12 +70,15 @@ class EvalConfig(Configurations):
     any_angle: bool  # also the optimal_any_angle stop rule (exact optimum)
     gpu: bool  # also the GPU-trained paper networks (paths.gpu_returned) as sources
     parts: list[int]  # trial parts: [0, 1, ..., K-1]
+    timing_noise: bool  # the protocol's RRT* timed twice (the machine's timing noise)
 
     def validate(self) -> None:
         """Raise :class:`ConfigError` naming the first invalid value."""
         super().validate()
         check_parts(self.parts, "eval.parts")
         check(isinstance(self.gpu, bool), "eval.gpu", self.gpu, "true or false")
+        ok = isinstance(self.timing_noise, bool)
+        check(ok, "eval.timing_noise", self.timing_noise, "true or false")
         for name in (
             "named_initial",
             "named_optimal",

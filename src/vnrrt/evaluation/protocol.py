@@ -114,6 +114,13 @@ class TrialJob:
     regime: str = ""
 
 
+def timed_twice(job: TrialJob) -> bool:
+    """Whether ``job`` runs twice when the stage measures the machine's timing noise
+    (``eval.timing_noise``): the protocol's RRT* (every configuration is compared with it)
+    outside the regime sweep."""
+    return job.key == ConfigKey("rrt_star") and job.regime == ""
+
+
 def trial_jobs(
     kinds: list[str],
     keys: list[ConfigKey],

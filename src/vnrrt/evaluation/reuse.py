@@ -30,7 +30,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from vnrrt.evaluation.protocol import TrialJob
+from vnrrt.evaluation.protocol import TrialJob, timed_twice
 from vnrrt.evaluation.table import TableError, read_table, write_table
 
 log = logging.getLogger(__name__)
@@ -118,9 +118,12 @@ def run_settings(job: TrialJob, configs: dict) -> dict:
     return out
 
 
-def group_digests(items: list, configs: dict, heat, seed: int, code: str) -> dict:
+def group_digests(items: list, configs: dict, heat, seed: int, code: str,
+                  repeat: bool = False) -> dict:  # fmt: skip
     """``{(key text, regime): (digest, [item index, ...])}`` of ``items`` (``(job, instance)``
-    pairs, the instance holding only the heatmap the job samples), in first-seen order."""
+    pairs, the instance holding only the heatmap the job samples), in first-seen order;
+    ``repeat``: whether the stage times some jobs twice (it changes only their digests:
+    :func:`~vnrrt.evaluation.protocol.timed_twice`)."""
     groups: dict[tuple[str, str], list[int]] = {}
     for i, (job, _) in enumerate(items):
         groups.setdefault((job.key.text, job.regime), []).append(i)
@@ -129,7 +132,8 @@ def group_digests(items: list, configs: dict, heat, seed: int, code: str) -> dic
         h = hashlib.sha256(f"{code}:{seed}:{digest(heat)}".encode())
         for i in idx:
             job, inst = items[i]
-            fields = (job.instance, job.key.text, job.stop, job.first, job.count, job.regime)
+            fields = (job.instance, job.key.text, job.stop, job.first, job.count, job.regime,
+                      repeat and timed_twice(job))  # fmt: skip
             h.update(digest(fields, run_settings(job, configs), inst).encode())
         out[group] = (h.hexdigest(), idx)
     return out

@@ -66,6 +66,10 @@ class TrialRow:
     mass_endpoints: float = math.nan  # on the start/goal disks
     mass_interior: float = math.nan  # near the interior vertices
     mass_path: float = math.nan  # near the rest of the path
+    # the machine's timing noise: the same run timed again later in the stage (same seed,
+    # same iterations; eval.timing_noise, protocol RRT* only; NaN where not repeated)
+    time_to_first_repeat: float = math.nan
+    time_to_stop_repeat: float = math.nan
 
     def record(self) -> dict:
         """The row as ``{column: value}`` (convergence times as ``t_<f>x`` columns)."""
@@ -80,7 +84,9 @@ CONVERGENCE_COLUMNS = tuple(convergence_column(f) for f in CONVERGENCE_FACTORS)
 COLUMNS = tuple(f.name for f in FIELDS) + CONVERGENCE_COLUMNS
 # Columns that measure time, and so change from run to run; every other column depends on
 # the inputs and seeds only (a re-run, or another split into parts, reproduces it exactly).
-TIMING_COLUMNS = ("time_to_first", "time_to_stop", "setup_time", *CONVERGENCE_COLUMNS)
+REPEAT_COLUMNS = ("time_to_first_repeat", "time_to_stop_repeat")
+TIMING_COLUMNS = ("time_to_first", "time_to_stop", "setup_time", *CONVERGENCE_COLUMNS,
+                  *REPEAT_COLUMNS)  # fmt: skip
 SEEDED_COLUMNS = tuple(c for c in COLUMNS if c not in TIMING_COLUMNS)
 _KINDS = {int: "int64", float: "float64", str: "object", bool: "bool"}
 DTYPES = {
@@ -100,7 +106,9 @@ def frame(rows: list[TrialRow]) -> pd.DataFrame:
 
 def conform(table: pd.DataFrame, where: str) -> pd.DataFrame:
     """``table`` with exactly :data:`COLUMNS` in order and their dtypes; :class:`TableError`
-    naming ``where`` if a column is missing."""
+    naming ``where`` if a column is missing (the :data:`REPEAT_COLUMNS`, absent from tables
+    written before they existed, read as NaN: not repeated)."""
+    table = table.assign(**{c: math.nan for c in REPEAT_COLUMNS if c not in table.columns})
     missing = [c for c in COLUMNS if c not in table.columns]
     if missing:
         raise TableError(f"trial table {where} lacks columns {missing} (re-run the trials)")

@@ -27,7 +27,7 @@ from vnrrt.data.heatmaps import HeatmapError
 from vnrrt.data.instances import EvalInstance
 from vnrrt.evaluation import reuse, sources
 from vnrrt.evaluation.keys import ConfigKey
-from vnrrt.evaluation.protocol import TrialJob, trial_jobs, trial_seed
+from vnrrt.evaluation.protocol import TrialJob, timed_twice, trial_jobs, trial_seed
 from vnrrt.evaluation.sampling import build_sampler, free_rule
 from vnrrt.evaluation.table import CONVERGENCE_FACTORS, TrialRow, conform, frame
 from vnrrt.infra.parallel import parallel_map
@@ -153,6 +153,45 @@ def _needed(job: TrialJob, inst: EvalInstance) -> tuple[TrialJob, EvalInstance]:
     return job, dataclasses.replace(inst, heatmaps=keep)
 
 
+def interleave(order: list[int], again: list[int]) -> list[tuple[int, bool]]:
+    """``(item, is_repeat)`` in run order: ``order``, with each item of ``again`` run a
+    second time, the repeats spread evenly over the run in reverse order (the first job's
+    second run comes last), so that a drift of the machine's speed during the stage shows
+    in the two timings as it shows between configurations."""
+    slots: dict[int, list[int]] = {}
+    for k, i in enumerate(reversed(again)):
+        at = min(len(order), math.ceil((k + 1) * len(order) / len(again))) - 1
+        slots.setdefault(at, []).append(i)
+    out = []
+    for p, i in enumerate(order):
+        out += [(i, False), *((j, True) for j in slots.get(p, []))]
+    return out
+
+
+def _timed(rows: list[TrialRow], again: list[TrialRow]) -> list[TrialRow]:
+    """``rows`` with the times of their second run (``again``, the same trials)."""
+    return [
+        dataclasses.replace(
+            r, time_to_first_repeat=a.time_to_first, time_to_stop_repeat=a.time_to_stop
+        )
+        for r, a in zip(rows, again, strict=True)
+    ]
+
+
+def _run(fn, items: list, order: list[int], repeat: bool, workers: int) -> dict[int, list]:
+    """``{item index: rows}`` of ``items[order]``; with ``repeat``, the jobs
+    that :func:`~vnrrt.evaluation.protocol.timed_twice` picks run twice
+    (:func:`interleave`) and their rows carry both timings."""
+    again = [i for i in order if repeat and timed_twice(items[i][0])]
+    schedule = interleave(order, again)
+    done = parallel_map(fn, [items[i] for i, _ in schedule], workers, "trials")
+    rows = {i: r for (i, second), r in zip(schedule, done, strict=True) if not second}
+    for (i, second), r in zip(schedule, done, strict=True):
+        if second:
+            rows[i] = _timed(rows[i], r)
+    return rows
+
+
 def run_jobs(
     jobs: list[TrialJob],
     instances: dict[int, EvalInstance],
@@ -161,19 +200,21 @@ def run_jobs(
     config: PlannerConfig | dict[str, PlannerConfig],
     heat: HeatSettings,
     store: str | Path | None = None,
+    repeat: bool = False,
 ) -> pd.DataFrame:
     """The rows of ``jobs`` (on ``instances[job.instance]``) as a trial table in ``seq``
     order. ``config``: the planner settings, or one per regime cell (label -> settings). A
     trial that exhausts a budget is a row with ``success=False``. With a ``store`` folder,
     a configuration whose inputs, settings and code are unchanged reuses its kept rows
-    (:mod:`vnrrt.evaluation.reuse`) and the others' rows are kept there."""
+    (:mod:`vnrrt.evaluation.reuse`) and the others' rows are kept there. With ``repeat``,
+    the protocol's RRT* runs twice (the ``*_repeat`` columns: the machine's timing noise)."""
     configs = config if isinstance(config, dict) else {"": config}
     fn = functools.partial(run_job, seed=seed, configs=configs, heat=heat)
     items = [_needed(job, instances[job.instance]) for job in jobs]
     if store is None:
-        rows = parallel_map(fn, items, workers, "trials")
-        return frame([r for rs in rows for r in rs])
-    groups = reuse.group_digests(items, configs, heat, seed, reuse.code_digest())
+        rows = _run(fn, items, list(range(len(items))), repeat, workers)
+        return frame([r for i in range(len(items)) for r in rows[i]])
+    groups = reuse.group_digests(items, configs, heat, seed, reuse.code_digest(), repeat)
     tables, todo = [], []
     for key, idx in groups.values():
         table = reuse.load(store, key, [items[i][0] for i in idx])
@@ -183,8 +224,7 @@ def run_jobs(
             tables.append(table)
     log.info(reuse.summary(len(tables), len(groups)))
     order = sorted(i for _, idx in todo for i in idx)  # the protocol's interleaved order
-    done = parallel_map(fn, [items[i] for i in order], workers, "trials")
-    rows = dict(zip(order, done, strict=True))
+    rows = _run(fn, items, order, repeat, workers)
     for key, idx in todo:  # each configuration kept as soon as the pool is done
         tables.append(frame([r for i in idx for r in rows[i]]))
         reuse.keep(store, key, tables[-1])

@@ -112,6 +112,7 @@ def run_trials_part(cfg: DictConfig, part: int) -> int:
     heat = HeatSettings(s["oracle"]["radius"], ev.endpoint_radius, targets,
                         zero_obstacles=ev.zero_obstacles)  # fmt: skip
     store = paths.reuse_store("trials")
-    table = run_jobs(jobs, instances, s["seed"], s["workers"], planner, heat, store)
+    table = run_jobs(jobs, instances, s["seed"], s["workers"], planner, heat, store,
+                     ev.timing_noise)  # fmt: skip
     write_table(table, paths.trials_part(part))
     return len(table)

@@ -108,10 +108,12 @@ def report_settings(cfg: DictConfig) -> dict:
     return typed | {"paper_settings": settings, "values": values}
 
 
-def report_text(s: dict, summary: dict, predict: dict, trainings: dict, optima: dict) -> str:
+def report_text(s: dict, summary: dict, predict: dict, trainings: dict, optima: dict,
+                against: tuple[list[dict] | None, str] = (None, "")) -> str:  # fmt: skip
     """``paper_comparison.md`` from stage ``report``'s settings ``s``, the ``summary``, the
-    networks' ``predict.json`` and training metrics (``trainings``: network -> metrics) and
-    the instances' optimal lengths (``optima``)."""
+    networks' ``predict.json`` and training metrics (``trainings``: network -> metrics), the
+    instances' optimal lengths (``optima``) and an ablation's claims against the default
+    run (``against``: :func:`against_default`)."""
     from vnrrt.evaluation.config import mask_taus
     from vnrrt.evaluation.protocol import configurations
     from vnrrt.studies.paper_comparison.report import ReportInputs, build_report, metric_settings
@@ -130,8 +132,36 @@ def report_text(s: dict, summary: dict, predict: dict, trainings: dict, optima: 
         s["paper_settings"],
         s["values"],
         trainings,
+        *against,
     )
     return build_report(inputs)
+
+
+def against_default(paths: Paths, summary: dict, params: str = "params.yaml"):
+    """``(changes, overrides text)`` of this run's claims against this scale's default run
+    (:func:`vnrrt.evaluation.noise.changes`). The default run (no setting changed from
+    ``conf/``'s composition) keeps its claims at ``paths.baseline`` and compares with
+    nothing: ``(None, "")``; so does an ablation run before any default run."""
+    from vnrrt.evaluation.noise import baseline_record, changes
+    from vnrrt.infra.io import read_json, write_json
+    from vnrrt.tracking.store import override_text, overrides
+
+    changed, rows = overrides(params), summary["claims"]["rows"]
+    if not changed:
+        write_json(paths.baseline, baseline_record(rows))
+        return None, ""
+    if not Path(paths.baseline).is_file():
+        return None, ""
+    stops = {name: spec["stop"] for name, spec in load_tables(paths)["tables"].items()}
+    noise = summary.get("timing_noise", {})
+    return changes(rows, stops, read_json(paths.baseline), noise), override_text(changed)
+
+
+def load_tables(paths: Paths) -> dict:
+    """The paper's tables (``paths.paper_tables``)."""
+    from vnrrt.studies.paper_tables import load_paper_tables
+
+    return load_paper_tables(paths.paper_tables)
 
 
 def gpu_trainings(paths: Paths) -> dict[str, dict]:
@@ -165,7 +195,8 @@ def run_report(cfg: DictConfig) -> Path:
     if ev.gpu:
         trainings |= gpu_trainings(paths)
     optima = Instances(paths.instances).optima()
-    write_text(paths.report, report_text(s, summary, predict, trainings, optima))
+    against = against_default(paths, summary)
+    write_text(paths.report, report_text(s, summary, predict, trainings, optima, against))
     figures = save_figures(paths, summary)
     metrics = headline(summary, predict["networks"])
     write_json(paths.headline, metrics)

@@ -116,6 +116,8 @@ def recompute(bundle: Path, out: Path) -> list[Path]:
     # every input comes from the bundle but the paper's numbers and settings, read where this
     # repository keeps them: the paths of this code, not of the run that made the bundle
     cfg.paths = compose([f"scale={cfg.scale.name}"]).paths
+    if "timing_noise" not in cfg.eval:  # a bundle from before the setting: RRT* timed once
+        cfg.eval.timing_noise = False
     predict, trainings = read_json(bundle / "predict.json"), read_json(bundle / "train.json")
     es = evaluate_settings(_view(cfg, "evaluate"))
     tables = checked_tables(bundle, es, read_json(bundle / "instances.json")["optima"])

@@ -24,6 +24,7 @@ from vnrrt.studies.paper_comparison.disclosure import (
     networks_scale_table,
     settings_table,
 )
+from vnrrt.studies.paper_comparison.timing import timing_section
 
 
 @dataclass(frozen=True)
@@ -405,8 +406,9 @@ class ReportInputs:
     ``settings``: ``tables.yaml`` and ``settings.yaml``), the instances' optimal lengths, each
     configuration's network (``sources``), the networks' heatmap metrics (``networks``,
     ``predict.json``, computed with ``metric_settings``) and training records
-    (``trainings``), and the run's value of every setting the settings table names
-    (``values``)."""
+    (``trainings``), the run's value of every setting the settings table names
+    (``values``), and in an ablation its claims against the default run's (``changes``,
+    :func:`vnrrt.evaluation.noise.changes`; ``overrides``: what the ablation changed)."""
 
     summary: dict
     paper: dict
@@ -418,6 +420,8 @@ class ReportInputs:
     settings: dict
     values: dict
     trainings: dict[str, dict]
+    changes: list[dict] | None = None
+    overrides: str = ""
 
 
 def build_report(inp: ReportInputs) -> str:
@@ -441,6 +445,7 @@ def build_report(inp: ReportInputs) -> str:
         multiple_note(summary["claims"]),
         "",
         *masked_claims_section(summary),
+        *timing_section(summary, inp.changes, inp.overrides),
         "## Settings: this run beside the paper",
         "",
         settings_table(inp.settings, inp.values),

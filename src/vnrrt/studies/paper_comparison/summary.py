@@ -11,6 +11,7 @@ import numpy as np
 import pandas as pd
 
 from vnrrt.evaluation.keys import ConfigKey
+from vnrrt.evaluation.noise import timing_noise
 from vnrrt.evaluation.protocol import STOPS
 from vnrrt.evaluation.stats import Summary, compare, summarize
 from vnrrt.evaluation.table import CONVERGENCE_COLUMNS, CONVERGENCE_FACTORS
@@ -138,6 +139,8 @@ def analyze(
     keys = list(dict.fromkeys(table["key"]))
     shares = mask_shares(table)
     timed = with_inference(table, inference_ms)
+    judged = claims(timed, paper, st, shares)
+    noise = timing_noise(table, judged["bootstrap"], judged["corrected_level"])
     return {
         "eps": eps,
         "level": level,
@@ -156,10 +159,10 @@ def analyze(
             m: speedups(table, "nrrt_star", m, n_boot, level)
             for m in ("time_to_stop", "iterations")
         },
-        "claims": claims(timed, paper, st, shares),
+        "claims": judged,
         "informed": informed_comparisons(table, n_boot, level),
         "setup_ms": {
             k: float(1e3 * sub["setup_time"].median())
             for k, sub in table.groupby("key", sort=False)
         },
-    }
+    } | ({"timing_noise": noise} if noise else {})
