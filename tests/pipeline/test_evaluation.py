@@ -20,6 +20,7 @@ from vnrrt.data.instances import Instances
 from vnrrt.data.manifest import build_manifest
 from vnrrt.data.shards import shard_file
 from vnrrt.evaluation.table import SEEDED_COLUMNS, TableError, merge_parts, read_table
+from vnrrt.infra.machine import describe
 from vnrrt.maps.config import DataConfig
 from vnrrt.pipeline.evaluation import run_instances, run_trials_part
 from vnrrt.pipeline.paper_comparison import run_evaluate, run_report
@@ -203,10 +204,13 @@ def test_report_stage_writes_report_figures_metrics_and_nested_mlflow_runs(cfg, 
         assert (figs / name).stat().st_size > 5000
     headline = json.loads((Path(cfg.paths.metrics) / "headline.json").read_text())
     assert sum(headline["verdicts"].values()) == 8  # one verdict per claim
-    variants = {"m0.5_max", "m0.5_noends", "m0.5_nrrtnet"}
-    assert set(headline["opt_ms"]) == {"rrt", "nrrt", "vnrrt", "m0.5", "m0.9", "m0.99", *variants}
-    assert headline["mass_x_uniform"] == {"vertexnet": 5.0, "nrrtnet": 4.0}
+    assert set(headline["opt_ms"]) == {"rrt", "nrrt", "vnrrt", "m"}  # M-VNRRT* at planner.tau
+    summary = json.loads(Path(cfg.paths.summary).read_text())
+    m = summary["cells"]["optimal"][f"m_vnrrt_star@{cfg.planner.tau:g}"]["random"]["time_to_stop"]
+    assert headline["opt_ms"]["m"] == round(1e3 * m["median"], 3)
+    assert headline["mass_x"] == {"vertexnet": 5.0, "nrrtnet": 4.0}
     assert headline["interior_ap"] == {"vertexnet": 0.12}
+    assert headline["machine"] == describe()
     mlflow.set_tracking_uri(cfg.logger.uri)
     runs = mlflow.search_runs(experiment_names=[cfg.logger.experiment])
     nested = runs["tags.mlflow.parentRunId"].notna()

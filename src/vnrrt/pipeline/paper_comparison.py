@@ -183,6 +183,7 @@ def run_report(cfg: DictConfig) -> Path:
     """Stage ``report`` (module doc); returns the report's path."""
     from vnrrt.data.instances import Instances
     from vnrrt.infra.io import read_json, write_json, write_text
+    from vnrrt.infra.machine import describe
     from vnrrt.studies.paper_comparison.report import headline
     from vnrrt.tracking import store as tracking
 
@@ -198,7 +199,7 @@ def run_report(cfg: DictConfig) -> Path:
     against = against_default(paths, summary)
     write_text(paths.report, report_text(s, summary, predict, trainings, optima, against))
     figures = save_figures(paths, summary)
-    metrics = headline(summary, predict["networks"])
+    metrics = headline(summary, predict["networks"], planner.tau, describe())
     write_json(paths.headline, metrics)
     if logger.enabled:
         from vnrrt.studies.paper_comparison.runs import EvaluationFiles, log_evaluation

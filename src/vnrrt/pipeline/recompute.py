@@ -34,6 +34,7 @@ BUNDLE = {  # file -> what it holds
     "train.json": "each network's training metrics (steps, images, time, architecture; with "
     "eval.gpu also the GPU-trained networks')",
 }
+MACHINE = "machine.json"  # optional: {"machine": the CPU whose timings the tables hold}
 
 
 def _view(cfg, stage: str):
@@ -69,8 +70,11 @@ def export(params: Path, out: Path) -> list[Path]:
 
         trainings |= gpu_trainings(paths)
     write_json(out / "train.json", trainings)
+    machine = read_json(paths.headline).get("machine")
+    if machine:  # optional: the machine that made the timings (MACHINE)
+        write_json(out / MACHINE, {"machine": machine})
     (out / "README.md").write_text(_schema())
-    return [out / name for name in (*BUNDLE, "README.md")]
+    return [out / name for name in (*BUNDLE, *([MACHINE] if machine else []), "README.md")]
 
 
 def _gzip(src: Path, dst: Path) -> None:
@@ -87,7 +91,8 @@ def _schema() -> str:
     from vnrrt.evaluation.table import COLUMNS, TrialRow
 
     lines = ["# Per-trial results behind the committed reports", "", "| file | holds |",
-             "| --- | --- |", *[f"| `{k}` | {v} |" for k, v in BUNDLE.items()], "",
+             "| --- | --- |", *[f"| `{k}` | {v} |" for k, v in BUNDLE.items()],
+             f"| `{MACHINE}` | the machine whose timings the tables hold (if recorded) |", "",
              "Trial table columns (`vnrrt.evaluation.table.TrialRow`):", ""]  # fmt: skip
     lines += [f"- `{c}`" for c in COLUMNS]
     lines += ["", TrialRow.__doc__.strip(), "",
@@ -128,7 +133,9 @@ def recompute(bundle: Path, out: Path) -> list[Path]:
     rs = report_settings(_view(cfg, "report"))
     optima = read_json(bundle / "instances.json")["optima"]
     write_text(out / "paper_comparison.md", report_text(rs, summary, predict, trainings, optima))
-    write_json(out / "headline.json", headline(summary, predict["networks"]))
+    machine = read_json(bundle / MACHINE)["machine"] if (bundle / MACHINE).is_file() else None
+    tau = float(cfg.planner.tau)
+    write_json(out / "headline.json", headline(summary, predict["networks"], tau, machine))
     ids = ideas_settings(_view(cfg, "ideas"))
     write_json(out / "ideas.json", ideas_summary({w: tables[w] for w in ("oracle", "regime")}, ids))
     write_text(out / "sampling_ideas.md", ideas_text(read_json(out / "ideas.json"), ids))

@@ -49,14 +49,20 @@ VERDICT_GROUPS = ("reproduced", "same direction", "no clear effect", "reversed")
 TARGET_MASKS = {"vertex": "interior", "path": "path"}  # what each network target is for
 
 
-def headline(summary: dict, networks: dict) -> dict:
-    """A dozen numbers for ``dvc metrics show``: each network's mass near what it is for (a
-    vertex network: the interior vertices; a path network: the path) as a multiple of a
-    uniform map's, the vertex networks' interior-vertex AP, the median planning time (ms) to
-    the A*-relative optimum on random maps per configuration, and the counts of verdicts on
-    the paper's claims. ``networks``: ``predict.json``'s metrics per network."""
-    out: dict = {"mass_x_uniform": {}, "opt_ms": {}, "verdicts": {}}
-    out["interior_ap"] = {}
+HEADLINE_PLANNERS = {"rrt_star": "rrt", "nrrt_star": "nrrt", "vnrrt_star": "vnrrt",
+                     "m_vnrrt_star": "m"}  # fmt: skip
+
+
+def headline(summary: dict, networks: dict, tau: float, machine: str | None = None) -> dict:
+    """The few numbers of ``dvc metrics show`` (one line each under ~300 characters in a
+    terminal; the full tables are in the report and MLflow): the counts of verdicts on the
+    paper's claims, each network's mass near what it is for (a vertex network: the interior
+    vertices; a path network: the path) as a multiple of a uniform map's, the vertex
+    networks' interior-vertex AP, the median planning time (ms) to the A*-relative optimum
+    on random maps of RRT*, NRRT*, VNRRT* and M-VNRRT* at ``tau`` (``planner.tau``), and
+    the ``machine`` whose timings these are (None: not recorded). ``networks``:
+    ``predict.json``'s metrics per network."""
+    out: dict = {"verdicts": {}, "mass_x": {}, "opt_ms": {}, "interior_ap": {}}
     for net, m in networks.items():
         target = TARGET_MASKS[m["target"]]
         share, uniform = (
@@ -64,23 +70,25 @@ def headline(summary: dict, networks: dict) -> dict:
             m.get(f"test/mass_near_{target}_uniform"),
         )
         if share is not None and uniform:
-            out["mass_x_uniform"][net] = round(share / uniform, 3)
+            out["mass_x"][net] = round(share / uniform, 3)
         if "test/interior_ap" in m and m["target"] == "vertex":
             out["interior_ap"][net] = round(m["test/interior_ap"], 4)
     for text, sets in summary["cells"].get("optimal", {}).items():
-        s = sets.get("random", {}).get("time_to_stop")
-        key = ConfigKey.parse(text)
-        if s is not None and not key.informed:
-            out["opt_ms"][key.short] = round(1e3 * s["median"], 3)
+        s, key = sets.get("random", {}).get("time_to_stop"), ConfigKey.parse(text)
+        protocol = ConfigKey(key.planner, tau if key.planner == "m_vnrrt_star" else None)
+        if s is not None and key == protocol:
+            out["opt_ms"][HEADLINE_PLANNERS[key.planner]] = round(1e3 * s["median"], 3)
     rows = summary["claims"]["rows"]
     verdicts = [r["verdict"] for r in rows if r["time_to_stop"]]  # one verdict per claim
-    out["claims_testable"] = sum(r["testability"]["testable"] for r in rows if r["time_to_stop"])
-    out["claims_contradicting_paper"] = sum(r["paper_data"] == CONTRADICTS for r in rows)
     for group in VERDICT_GROUPS:
-        out["verdicts"][group.replace("same direction", "same_dir").replace(" ", "_")] = sum(
-            v.startswith(group) for v in verdicts
-        )
-    return out
+        out["verdicts"][VERDICT_KEYS[group]] = sum(v.startswith(group) for v in verdicts)
+    out["testable"] = sum(r["testability"]["testable"] for r in rows if r["time_to_stop"])
+    out["contradicting"] = sum(r["paper_data"] == CONTRADICTS for r in rows)
+    return out | ({"machine": machine} if machine else {})
+
+
+VERDICT_KEYS = {"reproduced": "reproduced", "same direction": "same_dir",
+                "no clear effect": "no_effect", "reversed": "reversed"}  # fmt: skip
 
 
 def _num(v: float, digits: int = 3) -> str:

@@ -40,12 +40,12 @@ READINGS = {"time_to_stop": "planning_time", "iterations": "iterations",
             "time_total": "planning_plus_inference_time"}  # fmt: skip
 STATS = ("speedup", "ci_low", "ci_high", "ratio_of_means", "rom_ci_low", "rom_ci_high")
 HEATMAP_NAMES = {
-    "mass_x_uniform": "mass_near_target_x_uniform",
+    "mass_x": "mass_near_target_x_uniform",
     "interior_ap": "interior_vertex_ap",
 }
 PAPER_DATA = {COMPATIBLE: "compatible", CONTRADICTS: "contradicts"}  # the table's short words
 VERDICT_COUNTS = {"reproduced": "reproduced", "same_dir": "same_direction",
-                  "no_clear_effect": "no_clear_effect", "reversed": "reversed"}  # fmt: skip
+                  "no_effect": "no_clear_effect", "reversed": "reversed"}  # fmt: skip
 
 
 def planner_key(text: str) -> str:
@@ -82,8 +82,8 @@ def headline_metrics(summary: dict, headline: dict) -> dict[str, float]:
             out[metric_name("random_maps", "heatmap", name, net)] = float(value)
     for key, name in VERDICT_COUNTS.items():
         out[f"claims/count/{name}"] = float(headline["verdicts"].get(key, 0))
-    out["claims/count/testable"] = float(headline["claims_testable"])
-    out["claims/count/contradicting_paper_data"] = float(headline["claims_contradicting_paper"])
+    out["claims/count/testable"] = float(headline["testable"])
+    out["claims/count/contradicting_paper_data"] = float(headline["contradicting"])
     return out | claim_metrics(summary["claims"]["rows"])
 
 
