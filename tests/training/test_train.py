@@ -220,3 +220,27 @@ def test_training_metrics_update_on_every_nth_batch_only():
     assert module.val_metrics["vertex_recall"]._update_count == 1  # always in val and test
     with pytest.raises(ValueError, match="train_metrics_every"):
         VertexNetModule(nn.Conv2d(3, 2, 1), FocalLoss(), torch.optim.SGD, train_metrics_every=0)
+
+
+@pytest.mark.parametrize("log_model", [True, False])
+def test_the_test_metrics_are_logged_once(small_data, tmp_path, monkeypatch, log_model):
+    """Each test metric is one point of the training run (not Lightning's copy and then the
+    model's): linked to the logged model where the run logs one."""
+    from mlflow import MlflowClient
+
+    monkeypatch.setenv("DVC_STAGE", "train@vertexnet")
+    cfg = small_cfg(small_data, tmp_path, *QUICK, "logger.enabled=true",
+                    f"logger.log_model={str(log_model).lower()}")  # fmt: skip
+    metrics = train(cfg, "vertexnet")
+    client = MlflowClient(f"sqlite:///{tmp_path}/mlflow.db")
+    run = client.get_run(metrics["mlflow_run_id"])
+    tested = {k for k in metrics if k.startswith("test/")}
+    assert tested and tested <= set(run.data.metrics)
+    for key in tested:
+        history = client.get_metric_history(run.info.run_id, key)
+        assert len(history) == 1, (key, history)
+        assert history[0].value == pytest.approx(metrics[key])
+    if log_model:  # the same single points, linked to the logged model
+        model = client.get_logged_model(metrics["mlflow_model_id"])
+        assert tested <= {m.key for m in model.metrics}
+    assert any(k.startswith("train/") for k in run.data.metrics)  # the curves are still there

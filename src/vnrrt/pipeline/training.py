@@ -256,16 +256,19 @@ def train_network(cfg: DictConfig, network: str, files: TrainFiles,
 
 def finish_run(logger_cfg: tracking.LoggerConfig, scale: str, network: str, checkpoint: Path,
                logger, datamodule, metrics: dict, as_model: bool = True) -> dict:  # fmt: skip
-    """Tag the run with the checkpoint's hash and, with ``as_model`` and ``logger.log_model``,
-    log and register the network (:func:`vnrrt.training.runs.log_model`); returns what the
+    """Tag the run with the checkpoint's hash and log the test metrics once: with ``as_model``
+    and ``logger.log_model`` linked to the network, logged and registered
+    (:func:`vnrrt.training.runs.log_model`), else to the run alone; returns what the
     training metrics file records of the run."""
     from vnrrt.infra.io import sha256
     from vnrrt.training.runs import log_model
 
     logger.experiment.set_tag(logger.run_id, "checkpoint_sha256", sha256(checkpoint))
     out = {"mlflow_run_id": logger.run_id}
+    tested = {k: v for k, v in metrics.items() if k.startswith("test/")}
     if as_model and logger_cfg.log_model:
         example = datamodule.datasets["val"][0]["image"][None].numpy()  # (1, 3, S, S) float32
-        tested = {k: v for k, v in metrics.items() if k.startswith("test/")}
         out |= log_model(logger_cfg, scale, network, checkpoint, logger, example, tested)
+    else:
+        logger.log_metrics(tested, step=metrics.get("steps"))
     return out

@@ -133,8 +133,9 @@ def fit(
     """Train ``module`` (from ``resume``, a Lightning checkpoint, if given), write the final
     checkpoint to ``out``, test it and write the metrics to ``metrics_file``; returns them.
     ``with_val``: with the final validation's metrics (``val/...``; the budget curve's
-    trainings: its report, the target variants' selection). The pipeline's trainings leave
-    them out: their metrics files are ``dvc metrics show``'s rows."""
+    trainings: its report, the target variants' selection). The test metrics reach no
+    logger here: the run logs them once, linked to the logged model
+    (:func:`vnrrt.pipeline.training.finish_run`)."""
     first_step = resumed_step(resume)  # before the run overwrites its last.ckpt
     start = time.perf_counter()
     trainer.fit(module, datamodule=datamodule, ckpt_path=None if resume is None else str(resume))
@@ -142,7 +143,11 @@ def fit(
     val = validation_metrics(trainer) if with_val else {}  # before the test replaces them
     out.parent.mkdir(parents=True, exist_ok=True)
     save_final(trainer, out)
-    tested = trainer.test(module, datamodule=datamodule, verbose=False)[0]
+    loggers, trainer.loggers = trainer.loggers, []
+    try:
+        tested = trainer.test(module, datamodule=datamodule, verbose=False)[0]
+    finally:
+        trainer.loggers = loggers
     metrics = summary(trainer, tested, seconds, batch_size, first_step, val)
     if trainer.is_global_zero:
         write_json(metrics_file, metrics)
