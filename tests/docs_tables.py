@@ -21,11 +21,11 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 REPORTS = ROOT / "reports" / "cpu"
-VERDICTS = ("reproduced", "same_dir", "no_clear_effect", "reversed")
+VERDICTS = ("reproduced", "same_dir", "no_effect", "reversed")
 VERDICT_WORDS = {
     "reproduced": "reproduced",
     "same_dir": "same direction",
-    "no_clear_effect": "no clear effect",
+    "no_effect": "no clear effect",
     "reversed": "reversed",
 }
 
