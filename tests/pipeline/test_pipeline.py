@@ -585,7 +585,10 @@ def test_a_tau_ablation_reruns_only_m_vnrrt_and_moves_no_other_verdict(workdir):
     rows = [
         line
         for line in section.splitlines()
-        if line.startswith("| ") and "M-VNRRT*" not in line and "claim |" not in line
+        if line.startswith("| ")
+        and "---" not in line
+        and "M-VNRRT*" not in line
+        and "claim |" not in line
     ]
     assert rows and all("| +0.0% |" in r and "identical: re-timing only" in r for r in rows)
 
