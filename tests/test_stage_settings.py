@@ -44,6 +44,7 @@ CHANGED = {  # key -> a valid value other than the default's
     "eval.any_angle": False,
     "eval.informed": False,
     "eval.parts": [0, 1, 2],
+    "eval.timing_noise": False,
     "eval.mask_variants": ["max"],
     "eval.masked_controls": False,
     "eval.endpoint_radius": 2.0,
