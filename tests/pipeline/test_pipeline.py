@@ -239,6 +239,13 @@ def test_the_study_reads_in_mlflow_through_the_rest_api(workdir, tracking_server
     assert tags(evaluation)["ideas_run"] == ideas["info"]["run_id"]
     assert review.check_reports(rest, evaluation) == ["paper_comparison.md"]
     assert review.check_reports(rest, ideas) == ["sampling_ideas.md"]
+    bench = top["bench_maps"]  # the benchmark-maps study: its report as description and files
+    assert review.check_reports(rest, bench) == ["benchmark_maps.md"]
+    assert tags(bench)["mlflow.note.content"] == (workdir / "reports/benchmark_maps.md").read_text()
+    cells = review.read(workdir, "reports/metrics/benchmark_maps.json")["cells"]
+    (vnrrt,) = [c for c in cells if (c["map"], c["configuration"]) == ("pooled", "vnrrt_star")]
+    name = "pooled/within_5pct_of_exact_optimum/vnrrt/speedup_over_rrt_star/time_to_stop/speedup"
+    assert metrics(bench)[name] == vnrrt["time_to_stop"]["speedup"]
     predict = review.read(workdir, "reports/metrics/predict.json")
     run = top["predict"]
     assert "figures/heatmaps.png" in rest.artifact_paths(run["info"]["run_id"])

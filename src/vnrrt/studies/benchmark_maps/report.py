@@ -108,6 +108,7 @@ def _ood(summary: dict) -> list[str]:
 def build_report(summary: dict, scale: str) -> str:
     """The report's markdown (module doc)."""
     eps = summary["settings"]["eps"]
+    buckets = ", ".join(f"{n} {len(m['buckets'])}" for n, m in summary["maps"].items())
     lines = [
         "# Benchmark maps: the planners and learned samplers on MovingAI maps",
         "",
@@ -147,8 +148,9 @@ def build_report(summary: dict, scale: str) -> str:
         "## What the intervals can support",
         "",
         summary["caution"] + " Per map, the interval resamples that map's buckets "
-        f"({', '.join(str(len(m['buckets'])) for m in summary['maps'].values())} per map): "
-        "a statement about that map's queries of these lengths. Solve rates are counts "
+        f"({buckets}): a "
+        "statement about that map's queries of these lengths, with the same caution where "
+        "a map has few buckets. Solve rates are counts "
         f"within the budgets; where RRT* failed to come within {percent(eps)} and a "
         "configuration did not, that query's speed-up is a lower bound.",
         "",
