@@ -469,6 +469,9 @@ def check_names_its_values(work: Path, eps: float, taus: list[float], tau: float
         for default in absent:
             assert default not in text, (name, default)
         assert pct in text and ci in text, name
+    bench = (work / "reports/benchmark_maps.md").read_text()  # the benchmark-maps study
+    assert f"within {pct} of the exact optimum" in bench and f"{ci} paired bootstrap" in bench
+    assert not any(d in bench for d in absent) and f"M-VNRRT* τ={tau:g} |" in bench
     paper = reports["reports/paper_comparison.md"]
     assert f"eps = {eps:g}" in paper and ("## Informed sampling" in paper) == informed
     ours = {ln.split("|")[1].strip() for ln in paper.splitlines() if "| ours |" in ln}
@@ -513,8 +516,9 @@ def test_every_output_names_the_values_that_ran(workdir):
     check_names_its_values(workdir, 0.05, [0.3, 0.7], 0.5, 0.9, True, DEFAULT_TEXTS)
 
 
-EVALUATION_STAGES = ["evaluate", "ideas", "oracle@0", "predict_metrics", "regime@0", "report",
-                     "trials@0", "trials@1", "validate"]  # fmt: skip
+EVALUATION_STAGES = ["bench_maps@benchmark_maps", "evaluate", "ideas", "oracle@0",
+                     "predict_metrics", "regime@0", "report", "trials@0", "trials@1",
+                     "validate"]  # fmt: skip
 
 
 def test_an_ablation_would_rerun_only_the_evaluation(workdir):
