@@ -90,6 +90,10 @@ def test_a_missing_or_malformed_map_file_is_named(tmp_path):
     (tmp_path / "bad.map.scen").write_text("version 1\n")
     with pytest.raises(MovingAIError, match=r"bad\.map, line 6: unknown terrain 'x'"):
         read_benchmark(tmp_path, "bad")
+    (tmp_path / "bad.map").write_text("type octile\nheight 2\nwidth 2\nmap\n..\n..\n")
+    (tmp_path / "bad.map.scen").write_text("version 1\n0\tbad.map\t3\t2\t0\t0\t1\t1\t1.41421\n")
+    with pytest.raises(MovingAIError, match=r"bad\.map\.scen, line 2: scenario for a 3x2 map"):
+        read_benchmark(tmp_path, "bad")
 
 
 def test_the_configurations_and_jobs_cover_every_trial():
