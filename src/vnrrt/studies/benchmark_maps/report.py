@@ -91,6 +91,14 @@ def _ood(summary: dict) -> list[str]:
     names = summary["names"]
     pooled = {c["configuration"]: c for c in summary["cells"] if c["map"] == POOLED}
     out = [
+        "## Out of distribution against in distribution",
+        "",
+        "The same configurations' speed-ups over RRT* on the random test maps of the paper "
+        "comparison (`data/<scale>/summary.json`, stage `evaluate`: random floor maps like the "
+        "training maps), beside the pooled real-map ones. The two come from different queries "
+        "and are not paired: an interval that does not overlap the other suggests a "
+        "difference, overlapping ones do not show there is none.",
+        "",
         "| configuration | real maps (pooled), time | random maps, time | "
         "real maps (pooled), iterations | random maps, iterations |",
         "| --- | --- | --- | --- | --- |",
@@ -105,17 +113,30 @@ def _ood(summary: dict) -> list[str]:
     return out
 
 
-def build_report(summary: dict, scale: str) -> str:
-    """The report's markdown (module doc)."""
+def _support(summary: dict) -> list[str]:
     eps = summary["settings"]["eps"]
     buckets = ", ".join(f"{n} {len(m['buckets'])}" for n, m in summary["maps"].items())
+    return [
+        "## What the intervals can support",
+        "",
+        summary["caution"] + f" Per map, the interval resamples that map's buckets ({buckets}): "
+        "a statement about that map's queries of these lengths, with the same caution where "
+        "a map has few buckets. Solve rates are counts within the budgets; where RRT* failed "
+        f"to come within {percent(eps)} and a configuration did not, that query's speed-up is "
+        "a lower bound.",
+    ]
+
+
+def build_report(summary: dict, scale: str) -> str:
+    """The report's markdown (module doc)."""
     lines = [
         "# Benchmark maps: the planners and learned samplers on MovingAI maps",
         "",
         "RRT*, NRRT*, VNRRT* and M-VNRRT* with the trained networks, and the oracle envelopes "
         "(what a perfect heatmap of each idea gives), on the field's standard grid benchmarks "
         "(Sturtevant 2012; `data/movingai/`), "
-        f"{stop_name(STOP, eps)}. Written by stage `bench_maps@benchmark_maps`.",
+        f"{stop_name(STOP, summary['settings']['eps'])}. Written by stage "
+        "`bench_maps@benchmark_maps`.",
         "",
         "## Setup",
         "",
@@ -135,24 +156,9 @@ def build_report(summary: dict, scale: str) -> str:
         "",
         *_envelopes(summary),
         "",
-        "## Out of distribution against in distribution",
-        "",
-        "The same configurations' speed-ups over RRT* on the random test maps of the paper "
-        "comparison (`data/<scale>/summary.json`, stage `evaluate`: 200x200 maps like the "
-        "training maps), beside the pooled real-map ones. The two come from different queries "
-        "and are not paired: an interval that does not overlap the other suggests a "
-        "difference, overlapping ones do not show there is none.",
-        "",
         *_ood(summary),
         "",
-        "## What the intervals can support",
-        "",
-        summary["caution"] + " Per map, the interval resamples that map's buckets "
-        f"({buckets}): a "
-        "statement about that map's queries of these lengths, with the same caution where "
-        "a map has few buckets. Solve rates are counts "
-        f"within the budgets; where RRT* failed to come within {percent(eps)} and a "
-        "configuration did not, that query's speed-up is a lower bound.",
+        *_support(summary),
         "",
     ]
     return "\n".join(lines)
