@@ -146,7 +146,7 @@ def run_bench_maps(cfg: DictConfig, name: str) -> dict:
         raise ConfigError(f"report {name!r} is not in bench_maps.report {bm.report}")
     _check_store(logger)
     torch.set_num_threads(s["predict"]["threads"])
-    envelopes = envelope_keys(read_json(paths.ideas_summary)["selection"], bm.ideas)
+    envelopes = envelope_keys(read_json(paths.ideas_summary).get("selection", {}), bm.ideas)
     keys = configurations(s["eval"]["sources"], s["planner"].tau, envelopes)
     instances, maps = bench_instances(s)
     networks = sorted({k.source for k in keys if k.source and not k.named_source})

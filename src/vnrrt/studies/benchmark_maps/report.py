@@ -119,6 +119,12 @@ def _support(summary: dict) -> list[str]:
     return [
         "## What the intervals can support",
         "",
+        "Clusters: queries on one map share its structure and are not independent, so the "
+        "pooled interval resamples maps (then queries within them): the map is what changes "
+        "from one user's workload to the next. Within a map it resamples length buckets (then "
+        "queries), so that the interval carries how the speed-up changes with a query's "
+        "length, not only the scatter between queries of one length.",
+        "",
         summary["caution"] + f" Per map, the interval resamples that map's buckets ({buckets}): "
         "a statement about that map's queries of these lengths, with the same caution where "
         "a map has few buckets. Solve rates are counts within the budgets; where RRT* failed "
