@@ -220,6 +220,7 @@ def test_the_study_reads_in_mlflow_through_the_rest_api(workdir, tracking_server
     shows among its run's artifacts."""
     from vnrrt.data.instances import Instances
     from vnrrt.predict import heatmap
+    from vnrrt.studies.benchmark_maps.report import description
 
     rest = Rest(tracking_server.url)
     exp = rest.get("experiments/get-by-name", experiment_name="vnrrt-smoke")["experiment"]
@@ -241,8 +242,9 @@ def test_the_study_reads_in_mlflow_through_the_rest_api(workdir, tracking_server
     assert review.check_reports(rest, ideas) == ["sampling_ideas.md"]
     bench = top["bench_maps"]  # the benchmark-maps study: its report as description and files
     assert review.check_reports(rest, bench) == ["benchmark_maps.md"]
-    assert tags(bench)["mlflow.note.content"] == (workdir / "reports/benchmark_maps.md").read_text()
-    cells = review.read(workdir, "reports/metrics/benchmark_maps.json")["cells"]
+    studied = review.read(workdir, "reports/metrics/benchmark_maps.json")
+    assert tags(bench)["mlflow.note.content"] == description(studied, "smoke")
+    cells = studied["cells"]
     (vnrrt,) = [c for c in cells if (c["map"], c["configuration"]) == ("pooled", "vnrrt_star")]
     name = "pooled/within_5pct_of_exact_optimum/vnrrt/speedup_over_rrt_star/time_to_stop/speedup"
     assert metrics(bench)[name] == vnrrt["time_to_stop"]["speedup"]

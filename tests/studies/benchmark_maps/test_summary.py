@@ -12,7 +12,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from vnrrt.studies.benchmark_maps.report import build_report, ratio
+from vnrrt.studies.benchmark_maps.report import TAG_LIMIT, build_report, description, ratio
 from vnrrt.studies.benchmark_maps.summary import POOLED, analyze, pooled_caution
 
 ENVELOPES = {"vertex": "vnrrt_star~0.5[oracle_vertex@s4]"}
@@ -23,15 +23,16 @@ SETTINGS = {"eps": 0.02, "tau": 0.6, "max_iterations": 5000, "max_seconds": 2.0,
             "level": 0.9, "bootstrap": 300, "seed": 3, "trials": 2, "per_bucket": 1}  # fmt: skip
 
 
-def _table() -> pd.DataFrame:
-    """Two trials per (query, configuration): RRT* times t_q and 1.5 t_q, VNRRT* faster by a
-    per-query factor, the envelope faster still; RRT*'s second trial of query 0 fails."""
+def _table(queries=QUERIES, keys=KEYS) -> pd.DataFrame:
+    """Two trials per (query, configuration): RRT* times t_q and 1.5 t_q, the others faster
+    by a factor per query and configuration; RRT*'s second trial of query 0 fails."""
     rng = np.random.default_rng(0)
     rows = []
-    for q, (m, bucket) in enumerate(QUERIES):
+    for q, (m, bucket) in enumerate(queries):
         base = 0.01 * (q + 1)
-        factor = {"rrt_star": 1.0, KEYS[1]: 1.0 / (1.5 + q % 3), KEYS[2]: 0.1}
-        for key in KEYS:
+        factor = {k: 1.0 / (1.5 + (q + i) % 3) / (1 + 9 * (k in ENVELOPES.values()))
+                  for i, k in enumerate(keys)} | {"rrt_star": 1.0}  # fmt: skip
+        for key in keys:
             for t in range(2):
                 time = base * (1.0 + 0.5 * t) * factor[key] * (1 + 0.01 * rng.random())
                 fail = key == "rrt_star" and q == 0 and t == 1
@@ -118,3 +119,20 @@ def test_the_caution_says_what_few_maps_can_support():
     assert "nothing here speaks for other maps" in pooled_caution(1)
     assert ratio({"speedup": math.nan}) == "n/a"
     assert ratio({"speedup": 2.0, "ci_low": math.nan, "ci_high": 3.0}) == "2.00x"
+
+
+def test_the_run_description_holds_the_pooled_rows_within_mlflows_tag_limit():
+    """Four maps of four buckets and every configuration of the study: the description (an
+    MLflow tag) keeps the report's pooled rows and stays under the tag limit."""
+    envelopes = {"path": "nrrt_star~0.5[oracle_path@s1]", **ENVELOPES}
+    keys = ["rrt_star", "nrrt_star", "vnrrt_star", "m_vnrrt_star@0.5", *envelopes.values()]
+    names = ("arena", "lak304d", "64room_000", "losttemple")
+    queries = [(m, b) for m in names for b in (10, 40, 80, 120) for _ in range(3)]
+    maps = {m: {"width": 512, "height": 512, "buckets": [10, 40, 80, 120], "queries": 12,
+                "inference_ms": {"nrrtnet": 300.0, "vertexnet": 300.0}} for m in names}  # fmt: skip
+    big = analyze(_table(queries, keys), keys, envelopes, maps, SETTINGS, None)
+    text, report = description(big, "cpu"), build_report(big, "cpu")
+    assert len(text) < TAG_LIMIT < len(report)
+    pooled = [ln for ln in report.splitlines() if ln.startswith("| pooled |")]
+    assert len(pooled) == len(keys) + 3 and all(ln in text for ln in pooled[: len(keys)])
+    assert pooled_caution(4) in text and "| lak304d |" not in text

@@ -168,3 +168,20 @@ def build_report(summary: dict, scale: str) -> str:
         "",
     ]
     return "\n".join(lines)
+
+
+TAG_LIMIT = 8000  # characters MLflow keeps of a tag value (the run's description is a tag)
+
+
+def description(summary: dict, scale: str) -> str:
+    """The study's MLflow run description: the pooled rows of the speed-up table, the
+    out-of-distribution table and what the intervals can support (the whole report is the
+    run's artifact); under :data:`TAG_LIMIT` characters for any number of maps."""
+    pooled = {**summary, "cells": [c for c in summary["cells"] if c["map"] == POOLED]}
+    head = (
+        f"**The benchmark-maps study at scale `{scale}`** on {', '.join(summary['maps'])}, "
+        f"{stop_name(STOP, summary['settings']['eps'])}, pooled over the maps. Per map, the "
+        "networks against their envelopes and the setup: the report, `benchmark_maps.html` "
+        "under Artifacts."
+    )
+    return "\n".join([head, "", *_cells(pooled), "", *_ood(summary), "", *_support(summary), ""])

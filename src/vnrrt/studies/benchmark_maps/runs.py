@@ -7,9 +7,10 @@
   ``<map>/within_1pct_of_exact_optimum/<configuration>/speedup_over_rrt_star/time_to_stop/
   speedup``; each network against its envelope (``.../<configuration>_vs_<idea>_envelope/...``).
   A configuration is named by its short key (``vnrrt``, ``m0.5``) or ``<idea>_envelope``.
-* The report as the run's description and as artifacts (``benchmark_maps.md`` and ``.html``),
-  the summary and the trial table; the tag ``md5/<summary file>`` finds the run by its file
-  (:mod:`vnrrt.tracking.lineage`).
+* The description: the pooled speed-ups, the out-of-distribution table and what the
+  intervals support (:func:`~vnrrt.studies.benchmark_maps.report.description`); the report
+  as artifacts (``benchmark_maps.md`` and ``.html``), the summary and the trial table; the
+  tag ``md5/<summary file>`` finds the run by its file (:mod:`vnrrt.tracking.lineage`).
 """
 
 from __future__ import annotations
@@ -62,6 +63,7 @@ def log_bench_maps(
     markdown report; ``files``: the summary and trial table); returns its id."""
     import mlflow
 
+    from vnrrt.studies.benchmark_maps.report import description
     from vnrrt.tracking.report_artifacts import log_report
 
     uri, exp, tags = tracking.open_experiment(logger, KIND, scale)
@@ -77,5 +79,5 @@ def log_bench_maps(
         log_report(client, run.info.run_id, Path(report))
         for path in files:
             client.log_artifact(run.info.run_id, str(path))
-        client.set_tag(run.info.run_id, "mlflow.note.content", Path(report).read_text())
+        client.set_tag(run.info.run_id, "mlflow.note.content", description(summary, scale))
         return run.info.run_id
