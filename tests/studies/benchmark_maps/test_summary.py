@@ -38,7 +38,8 @@ def _table(queries=QUERIES, keys=KEYS) -> pd.DataFrame:
                 fail = key == "rrt_star" and q == 0 and t == 1
                 rows.append({"instance": q, "map_set": m, "cluster": bucket, "key": key,
                              "trial": t, "success": not fail, "time_to_stop": time,
-                             "iterations": int(time * 1e5)})  # fmt: skip
+                             "iterations": int(time * 1e5),
+                             "fallback_uniform": key == keys[1] and m == "lak"})  # fmt: skip
     return pd.DataFrame(rows)
 
 
@@ -89,6 +90,9 @@ def test_solve_rates_count_the_failed_trials(summary):
     assert _cell(summary, POOLED, "rrt_star")["trials"] == 12
     assert _cell(summary, "lak", "rrt_star")["solve_rate"] == 1.0
     assert "time_to_stop" not in _cell(summary, POOLED, "rrt_star")  # the baseline
+    assert _cell(summary, "lak", "vnrrt_star")["fallbacks"] == 6
+    assert _cell(summary, POOLED, "vnrrt_star")["fallbacks"] == 6
+    assert _cell(summary, "arena", "vnrrt_star")["fallbacks"] == 0
 
 
 def test_networks_against_their_envelope_and_in_distribution(summary):

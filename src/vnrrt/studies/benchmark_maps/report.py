@@ -61,14 +61,15 @@ def _cells(summary: dict) -> list[str]:
     names = summary["names"]
     out = [
         "| map | configuration | solved | median ms | median iterations | "
-        "speed-up, time | speed-up, iterations |",
-        "| --- | --- | --- | --- | --- | --- | --- |",
+        "speed-up, time | speed-up, iterations | uniform fallbacks |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- |",
     ]
     for c in summary["cells"]:
         t, i = (ratio(c[m]) if m in c else "1 (baseline)" for m in ("time_to_stop", "iterations"))
         out.append(
             f"| {c['map']} | {names[c['configuration']]} | {c['solved']}/{c['trials']} "
-            f"| {c['median_ms']:.1f} | {c['median_iterations']:,.0f} | {t} | {i} |"
+            f"| {c['median_ms']:.1f} | {c['median_iterations']:,.0f} | {t} | {i} "
+            f"| {c['fallbacks']} |"
         )
     return out
 
@@ -151,7 +152,9 @@ def build_report(summary: dict, scale: str) -> str:
         "## Solve rates and speed-ups over RRT*",
         "",
         "Speed-up: geometric mean over queries of median(RRT*) / median(configuration), "
-        "time to the stop rule and iterations (+1); above 1 is faster than RRT*.",
+        "time to the stop rule and iterations (+1); above 1 is faster than RRT*. Uniform "
+        "fallbacks: trials whose heatmap had no weight left to sample (M-VNRRT* with no "
+        "pixel at or above its threshold), which then sample uniformly, as RRT*.",
         "",
         *_cells(summary),
         "",

@@ -63,12 +63,14 @@ def _speedup(base: pd.DataFrame, plan: pd.DataFrame, metric: str, stats: dict) -
 
 
 def cell(sub: pd.DataFrame, base: pd.DataFrame, key: str, stats: dict) -> dict:
-    """One configuration's row on one map (or pooled): trials, solved, solve rate, median
-    planning ms and iterations (failures at their budget), speed-ups over RRT*."""
+    """One configuration's row on one map (or pooled): trials, solved, solve rate, trials
+    whose heatmap sampler fell back to uniform sampling (M-VNRRT* with nothing above tau),
+    median planning ms and iterations (failures at their budget), speed-ups over RRT*."""
     out = {
         "trials": int(len(sub)),
         "solved": int(sub["success"].sum()),
         "solve_rate": float(sub["success"].mean()),
+        "fallbacks": int(sub["fallback_uniform"].sum()),
         "median_ms": float(np.median(sub["time_to_stop"]) * 1e3),
         "median_iterations": float(np.median(sub["iterations"])),
     }
