@@ -55,7 +55,7 @@ CPU_REPORTS := reports/cpu
 # oracle selection, ~26 min the oracle evaluation and regime grid (regime@0, 49,980 jobs of 2
 # planner runs), ~3 min the reports; ~37 min for seed 1's trainings; ~63 min the budget
 # curve.
-repro-cpu: $(STAMP)  ## the CPU study scale (about 3 h on 2 cores): the pipeline at seed 0 (reports first), both networks at train.seed 1, the training-budget curve; reports copied to reports/cpu/, the per-trial tables behind them to reports/cpu/results/
+repro-cpu: $(STAMP)  ## the CPU study scale (about 3 h on 2 cores): the pipeline at seed 0 (reports first), both networks at train.seed 1, the training-budget curve and the benchmark-maps study; reports copied to reports/cpu/, the per-trial tables behind them to reports/cpu/results/
 	$(BIN)/dvc exp run -S scale=cpu ideas report
 	rm -rf $(CPU_REPORTS) && mkdir -p $(CPU_REPORTS)/seed1
 	cp -r reports/paper_comparison.md reports/sampling_ideas.md reports/metrics reports/figures $(CPU_REPORTS)/
@@ -63,7 +63,7 @@ repro-cpu: $(STAMP)  ## the CPU study scale (about 3 h on 2 cores): the pipeline
 	$(BIN)/dvc exp run -S scale=cpu -S train.seed=1 predict_metrics
 	cp reports/metrics/train_*.json reports/metrics/predict.json $(CPU_REPORTS)/seed1/
 	$(BIN)/dvc exp run -S scale=cpu
-	cp -r reports/training_budget.md reports/metrics reports/figures $(CPU_REPORTS)/
+	cp -r reports/training_budget.md reports/benchmark_maps.md reports/metrics reports/figures $(CPU_REPORTS)/
 
 repro-cpu-budget-seed1: $(STAMP)  ## after repro-cpu: the training-budget curve at train.seed 1 (~75 min on 2 cores); to reports/cpu/seed1/
 	$(BIN)/dvc exp run -S scale=cpu -S train.seed=1 budget_report@training_budget

@@ -62,7 +62,8 @@ def trained(small_data, tmp_path_factory) -> Path:
     return out
 
 
-PIPELINE_FILES = ["dvc.yaml", "conf", "stages", "src", ".dvcignore", "data/paper", "reports/gpu"]
+PIPELINE_FILES = ["dvc.yaml", "conf", "stages", "src", ".dvcignore", "data/paper", "data/movingai",
+                  "reports/gpu"]  # fmt: skip
 DVC_FILES = [".dvc/config", ".dvc/plots/series.json"]  # copied after `dvc init`
 
 

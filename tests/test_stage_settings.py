@@ -15,6 +15,7 @@ import yaml
 from tests.stage_closure import REPO
 from vnrrt.config import compose, restrict, stage_params
 from vnrrt.pipeline import training_budget as budget
+from vnrrt.pipeline.benchmark_maps import bench_settings
 from vnrrt.pipeline.evaluation import instances_settings, trials_settings
 from vnrrt.pipeline.paper_comparison import evaluate_settings, report_settings
 from vnrrt.pipeline.sampling_ideas import ideas_settings, part_settings
@@ -30,6 +31,7 @@ SETTINGS = {
     "ideas": ideas_settings,
     "budget_trials": budget.trials_settings,
     "budget_report": budget.report_settings,
+    "bench_maps": bench_settings,
     "validate": validate_config,
 }
 DICT_VALUES = ("sources", "families")  # keys whose values are dicts

@@ -220,6 +220,7 @@ def test_the_study_reads_in_mlflow_through_the_rest_api(workdir, tracking_server
     shows among its run's artifacts."""
     from vnrrt.data.instances import Instances
     from vnrrt.predict import heatmap
+    from vnrrt.studies.benchmark_maps.report import description
 
     rest = Rest(tracking_server.url)
     exp = rest.get("experiments/get-by-name", experiment_name="vnrrt-smoke")["experiment"]
@@ -239,6 +240,14 @@ def test_the_study_reads_in_mlflow_through_the_rest_api(workdir, tracking_server
     assert tags(evaluation)["ideas_run"] == ideas["info"]["run_id"]
     assert review.check_reports(rest, evaluation) == ["paper_comparison.md"]
     assert review.check_reports(rest, ideas) == ["sampling_ideas.md"]
+    bench = top["bench_maps"]  # the benchmark-maps study: its report as description and files
+    assert review.check_reports(rest, bench) == ["benchmark_maps.md"]
+    studied = review.read(workdir, "reports/metrics/benchmark_maps.json")
+    assert tags(bench)["mlflow.note.content"] == description(studied, "smoke")
+    cells = studied["cells"]
+    (vnrrt,) = [c for c in cells if (c["map"], c["configuration"]) == ("pooled", "vnrrt_star")]
+    name = "pooled/within_5pct_of_exact_optimum/vnrrt/speedup_over_rrt_star/time_to_stop/speedup"
+    assert metrics(bench)[name] == vnrrt["time_to_stop"]["speedup"]
     predict = review.read(workdir, "reports/metrics/predict.json")
     run = top["predict"]
     assert "figures/heatmaps.png" in rest.artifact_paths(run["info"]["run_id"])
@@ -462,6 +471,9 @@ def check_names_its_values(work: Path, eps: float, taus: list[float], tau: float
         for default in absent:
             assert default not in text, (name, default)
         assert pct in text and ci in text, name
+    bench = (work / "reports/benchmark_maps.md").read_text()  # the benchmark-maps study
+    assert f"within {pct} of the exact optimum" in bench and f"{ci} paired bootstrap" in bench
+    assert not any(d in bench for d in absent) and f"M-VNRRT* τ={tau:g} |" in bench
     paper = reports["reports/paper_comparison.md"]
     assert f"eps = {eps:g}" in paper and ("## Informed sampling" in paper) == informed
     ours = {ln.split("|")[1].strip() for ln in paper.splitlines() if "| ours |" in ln}
@@ -506,8 +518,9 @@ def test_every_output_names_the_values_that_ran(workdir):
     check_names_its_values(workdir, 0.05, [0.3, 0.7], 0.5, 0.9, True, DEFAULT_TEXTS)
 
 
-EVALUATION_STAGES = ["evaluate", "ideas", "oracle@0", "predict_metrics", "regime@0", "report",
-                     "trials@0", "trials@1", "validate"]  # fmt: skip
+EVALUATION_STAGES = ["bench_maps@benchmark_maps", "evaluate", "ideas", "oracle@0",
+                     "predict_metrics", "regime@0", "report", "trials@0", "trials@1",
+                     "validate"]  # fmt: skip
 
 
 def test_an_ablation_would_rerun_only_the_evaluation(workdir):

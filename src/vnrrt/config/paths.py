@@ -63,6 +63,10 @@ class Paths:
     ideas_figures: str
     budget_summary: str
     budget_figures: str
+    movingai: str
+    bench_maps_trials: str
+    bench_maps_summary: str
+    bench_maps_report: str
 
     def validate(self) -> None:
         """Raise :class:`ConfigError` for an empty path."""
@@ -194,6 +198,7 @@ def stage_outputs(stage: str, paths: Paths, item=None) -> list[Path]:
         ],
         "budget_trials": lambda: [p.budget_trials(int(item))],
         "budget_report": lambda: [p.budget_summary, p.budget_report, p.budget_figures],
+        "bench_maps": lambda: [p.bench_maps_trials, p.bench_maps_summary, p.bench_maps_report],
         "predict": lambda: [p.heatmaps_part(int(item)), p.timing_part(int(item))],
         "predict_metrics": lambda: [p.predict_metrics, p.heatmaps_figure],
         "trials": lambda: [p.trials_part(int(item))],

@@ -22,6 +22,7 @@ from vnrrt.evaluation.keys import ConfigKey
 from vnrrt.evaluation.sources import is_oracle
 from vnrrt.maps.config import DataConfig
 from vnrrt.planners.config import PlannerConfig
+from vnrrt.studies.benchmark_maps.config import BenchMapsConfig, map_files
 from vnrrt.studies.training_budget.budget import BudgetConfig, batches_per_epoch
 from vnrrt.tracking.store import LoggerConfig
 
@@ -110,7 +111,10 @@ def validate_config(cfg: DictConfig) -> dict:
         "paths": section(cfg, "paths", Paths),
         "logger": section(cfg, "logger", LoggerConfig),
         "budget": section(cfg, "budget", BudgetConfig),
+        "bench_maps": section(cfg, "bench_maps", BenchMapsConfig),
     }
+    for name in typed["bench_maps"].maps:  # a missing map file stops the run here
+        map_files(typed["paths"].movingai, name)
     for steps in typed["budget"].steps:
         batches_per_epoch(steps, int(cfg.trainer.max_epochs))
     _taus(typed["planner"])
