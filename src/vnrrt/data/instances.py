@@ -148,6 +148,12 @@ class Instances:
             }
         return out
 
+    def turns(self) -> dict[int, int]:
+        """``{instance: turning points}``: the interior vertices of each exact optimum
+        (``exact_points`` holds start and goal too)."""
+        counts = np.diff(self.arrays["exact_offsets"]) - 2
+        return {i: int(c) for i, c in enumerate(counts)}
+
     def named(self) -> dict[str, str]:
         """``{map_set: name}`` of the named maps (``map_1``: ``open_room``, ...)."""
         a = self.arrays
