@@ -29,7 +29,8 @@ BUNDLE = {  # file -> what it holds
     "trials.csv.gz": "the paper comparison's trials, one row per planner run",
     "oracle.csv.gz": "the oracle study's trials",
     "regime.csv.gz": "the regime sweep's trials",
-    "instances.json": "per map set the A*, exact and taut optimal lengths; the named maps",
+    "instances.json": "per map set the A*, exact and taut optimal lengths; the named maps; "
+    "each instance's turning points (the strata)",
     "predict.json": "the networks' heatmap metrics, inference times and their settings",
     "train.json": "each network's training metrics (steps, images, time, architecture; with "
     "eval.gpu also the GPU-trained networks')",
@@ -60,7 +61,9 @@ def export(params: Path, out: Path) -> list[Path]:
         _gzip(out / f"{which}.csv", out / f"{which}.csv.gz")
         (out / f"{which}.csv").unlink()
     inst = Instances(paths.instances)
-    write_json(out / "instances.json", {"optima": inst.optima(), "named": inst.named()})
+    turns = {str(i): n for i, n in inst.turns().items()}
+    write_json(out / "instances.json", {"optima": inst.optima(), "named": inst.named(),
+                                        "turns": turns})  # fmt: skip
     predict = read_json(paths.predict_metrics)
     write_json(out / "predict.json", predict)
     trainings = {n: read_json(paths.train_metrics(n)) for n in predict["networks"]}
@@ -120,7 +123,7 @@ def recompute(bundle: Path, out: Path) -> list[Path]:
     es = evaluate_settings(_view(cfg, "evaluate"))
     tables = checked_tables(bundle, es, read_json(bundle / "instances.json")["optima"])
     out.mkdir(parents=True, exist_ok=True)
-    summary = evaluate_summary(tables["trials"], es, predict)
+    summary = evaluate_summary(tables["trials"], es, predict, bundle_turns(bundle))
     write_json(out / "summary.json", summary)
     summary = read_json(out / "summary.json")  # as the report stage reads it
     rs = report_settings(_view(cfg, "report"))
@@ -132,6 +135,15 @@ def recompute(bundle: Path, out: Path) -> list[Path]:
     write_text(out / "sampling_ideas.md", ideas_text(read_json(out / "ideas.json"), ids))
     names = ("summary.json", "paper_comparison.md", "headline.json", "ideas.json")
     return [out / n for n in (*names, "sampling_ideas.md")]
+
+
+def bundle_turns(bundle: Path) -> dict[int, int] | None:
+    """Each instance's turning points from the bundle's ``instances.json`` (None where the
+    bundle predates them: ``python -m vnrrt.pipeline.bundle_turns`` adds them)."""
+    from vnrrt.infra.io import read_json
+
+    turns = read_json(bundle / "instances.json").get("turns")
+    return None if turns is None else {int(i): int(n) for i, n in turns.items()}
 
 
 def checked_tables(bundle: Path, es: dict, optima: dict) -> dict:
