@@ -12,6 +12,7 @@ import math
 from vnrrt.evaluation.keys import ConfigKey, label
 from vnrrt.names import level_name, percent, stop_name
 from vnrrt.studies.sampling_ideas.design import PROTOCOL
+from vnrrt.studies.sampling_ideas.edges import edge_note
 from vnrrt.studies.sampling_ideas.summary import sweep_columns
 
 IDEAS = ("path", "vertex", "blend", "control")
@@ -59,7 +60,9 @@ def _envelope_findings(summary: dict, stop: str, eps: float) -> list[str]:
     }
     out = []
     cells = {i: _cell(summary, PROTOCOL, stop, env.get(i)) for i in IDEAS}
-    said = "; ".join(f"{i} {_x((cells[i] or {}).get('iterations'))}" for i in IDEAS if cells[i])
+    edges = summary["selection"].get("edges", {}).get(stop, {})
+    said = "; ".join(f"{i} {_x((cells[i] or {}).get('iterations'))}{edge_note(edges.get(i))}"
+                     for i in IDEAS if cells[i])  # fmt: skip
     if said:
         out.append(
             f"Envelopes ({stop_name(stop, eps)}, the protocol's cell, fewer iterations "
@@ -224,17 +227,28 @@ def quality_needed(summary: dict, eps: float) -> list[str]:
 
 
 def selection_table(summary: dict, stop: str) -> str:
-    """Per family: members tried, the envelope chosen and its selection speed-up."""
+    """Per family: members tried, the envelope chosen, its selection speed-up and whether it
+    sits on its grid's edge (:mod:`.edges`)."""
     sel = summary["selection"]
     lines = [
-        "| family | members | envelope (chosen) | its speed-up on the selection |",
-        "| --- | --- | --- | --- |",
+        "| family | members | envelope (chosen) | its speed-up on the selection | on its grid's "
+        "edge? |",
+        "| --- | --- | --- | --- | --- |",
     ]
     for idea, cells in sel["speedups"].get(stop, {}).items():
         chosen = sel["envelopes"].get(stop, {}).get(idea)
         if chosen:
-            lines.append(f"| {idea} | {len(cells)} | {label(chosen)} | {cells[chosen]:.2f}x |")
+            e = sel.get("edges", {}).get(stop, {}).get(idea)
+            where = "—" if e is None else _edge_cell(e)
+            lines.append(
+                f"| {idea} | {len(cells)} | {label(chosen)} | {cells[chosen]:.2f}x | {where} |"
+            )
     return "\n".join(lines)
+
+
+def _edge_cell(edges: list[str]) -> str:
+    """An envelope's place on its grid: its edges, or interior (a bound)."""
+    return "; ".join(edges) + ": the best measured member" if edges else "no: interior, a bound"
 
 
 def envelope_table(summary: dict, stop: str) -> str:

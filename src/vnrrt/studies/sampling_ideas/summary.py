@@ -18,6 +18,7 @@ from vnrrt.evaluation.keys import ConfigKey, label
 from vnrrt.evaluation.sources import OracleSource
 from vnrrt.evaluation.stats import compare
 from vnrrt.studies.sampling_ideas import design as d
+from vnrrt.studies.sampling_ideas.edges import envelope_edges
 from vnrrt.studies.sampling_ideas.selection import member_speedups, select
 
 BASELINE = ConfigKey("rrt_star")
@@ -265,6 +266,7 @@ def analyze_study(tables: dict, study: dict, pairs: list[tuple[str, str]], setti
         "selection": {
             "speedups": speedups,
             "envelopes": envelopes,
+            "edges": envelope_edges(envelopes, oc),
             "instances": int(sel["instance"].nunique()),
             "maps": sorted(int(c) for c in sel["cluster"].unique()),
         },
