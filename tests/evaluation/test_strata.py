@@ -45,8 +45,7 @@ def block_and_wall():
 
 @pytest.mark.parametrize(
     ("make", "turns", "stratum"),
-    [(open_map, 0, "line of sight"), (one_wall, 1, "1-2 turns"),
-     (block_and_wall, 3, "3+ turns")],  # fmt: skip
+    [(open_map, 0, "line of sight"), (one_wall, 1, "1-2 turns"), (block_and_wall, 3, "3+ turns")],
 )
 def test_the_stratum_of_a_hand_made_map(make, turns, stratum):
     grid, start, goal, corners = make()

@@ -1,4 +1,5 @@
-"""Turning points of a results bundle's instances, rebuilt where the bundle predates them.
+"""Turning points and free cells of a results bundle's instances, rebuilt where the bundle
+predates them.
 
 A bundle exported before the strata (``instances.json`` without ``turns``) still names each
 instance: a named map by its map set, a random instance as ``map<id>/inst<i>`` (global map
@@ -9,8 +10,9 @@ optimum recomputed (:func:`vnrrt.search.any_angle_path`), and each length checke
 the bundle's own reference of stop ``optimal_any_angle`` (the exact optimum the trials used):
 a map rebuilt wrong is refused, never used.
 
-``python -m vnrrt.pipeline.bundle_turns --bundle reports/cpu/results`` adds ``turns`` to the
-bundle's ``instances.json``.
+``python -m vnrrt.pipeline.bundle_turns --bundle reports/cpu/results`` adds ``turns`` and
+``free_cells`` (each instance's map, the RRT* gamma's area) to the bundle's
+``instances.json``.
 """
 
 from __future__ import annotations
@@ -39,9 +41,10 @@ def _problem(row, data, size: int, seed: int, per_shard: int):
     return fm.grid, tuple(fm.starts[start] + 0.5), tuple(fm.goals[goal] + 0.5)
 
 
-def bundle_turns(bundle: Path) -> dict[int, int]:
-    """``{instance: turning points}`` of every instance of the bundle's paper comparison,
-    each exact length checked against the bundle's (module doc); ValueError on a mismatch."""
+def bundle_turns(bundle: Path) -> tuple[dict[int, int], dict[int, int]]:
+    """``({instance: turning points}, {instance: free cells})`` of every instance of the
+    bundle's paper comparison, each exact length checked against the bundle's (module doc);
+    ValueError on a mismatch."""
     import pandas as pd
 
     from vnrrt.config import load_params, section
@@ -54,16 +57,18 @@ def bundle_turns(bundle: Path) -> dict[int, int]:
     rows = table[table["stop"] == "optimal_any_angle"].groupby("instance").first()
     if rows.empty:
         raise ValueError(f"{bundle}: no optimal_any_angle trials to check rebuilt maps against")
-    out = {}
+    out, free = {}, {}
     for inst, row in rows.iterrows():
         grid, start, goal = _problem(row, data, int(cfg.data.size), int(cfg.seed),
                                      int(cfg.scale.maps_per_shard))  # fmt: skip
         points, length = any_angle_path(grid, start, goal)
         if not math.isclose(length, row["reference_length"], rel_tol=1e-9):
+            want = row["reference_length"]
             raise ValueError(f"{bundle}: instance {inst} ({row['map']}) rebuilt with exact "
-                             f"length {length}, the bundle's is {row['reference_length']}")  # fmt: skip
+                             f"length {length}, the bundle's {want}")  # fmt: skip
         out[int(inst)] = len(np.asarray(points)) - 2
-    return out
+        free[int(inst)] = int(np.count_nonzero(np.asarray(grid) == 0))
+    return out, free
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -75,12 +80,14 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--bundle", type=Path, required=True)
     args = parser.parse_args(argv)
     try:
-        turns = bundle_turns(args.bundle)
+        turns, free = bundle_turns(args.bundle)
     except (OSError, ValueError) as err:
         print(f"vnrrt.pipeline.bundle_turns: error: {err}".splitlines()[0], file=sys.stderr)
         return 2
     path = args.bundle / "instances.json"
-    write_json(path, read_json(path) | {"turns": {str(i): turns[i] for i in sorted(turns)}})
+    add = {"turns": {str(i): turns[i] for i in sorted(turns)},
+           "free_cells": {str(i): free[i] for i in sorted(free)}}  # fmt: skip
+    write_json(path, read_json(path) | add)
     print(path)
     return 0
 

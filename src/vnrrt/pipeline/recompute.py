@@ -30,7 +30,7 @@ BUNDLE = {  # file -> what it holds
     "oracle.csv.gz": "the oracle study's trials",
     "regime.csv.gz": "the regime sweep's trials",
     "instances.json": "per map set the A*, exact and taut optimal lengths; the named maps; "
-    "each instance's turning points (the strata)",
+    "each instance's turning points (the strata) and free cells (the distinct regime cells)",
     "predict.json": "the networks' heatmap metrics, inference times and their settings",
     "train.json": "each network's training metrics (steps, images, time, architecture; with "
     "eval.gpu also the GPU-trained networks')",
@@ -62,8 +62,9 @@ def export(params: Path, out: Path) -> list[Path]:
         (out / f"{which}.csv").unlink()
     inst = Instances(paths.instances)
     turns = {str(i): n for i, n in inst.turns().items()}
+    free = {str(i): n for i, n in inst.free_cells().items()}
     write_json(out / "instances.json", {"optima": inst.optima(), "named": inst.named(),
-                                        "turns": turns})  # fmt: skip
+                                        "turns": turns, "free_cells": free})  # fmt: skip
     predict = read_json(paths.predict_metrics)
     write_json(out / "predict.json", predict)
     trainings = {n: read_json(paths.train_metrics(n)) for n in predict["networks"]}
@@ -123,7 +124,7 @@ def recompute(bundle: Path, out: Path) -> list[Path]:
     es = evaluate_settings(_view(cfg, "evaluate"))
     tables = checked_tables(bundle, es, read_json(bundle / "instances.json")["optima"])
     out.mkdir(parents=True, exist_ok=True)
-    summary = evaluate_summary(tables["trials"], es, predict, bundle_turns(bundle))
+    summary = evaluate_summary(tables["trials"], es, predict, bundle_field(bundle, "turns"))
     write_json(out / "summary.json", summary)
     summary = read_json(out / "summary.json")  # as the report stage reads it
     rs = report_settings(_view(cfg, "report"))
@@ -131,19 +132,21 @@ def recompute(bundle: Path, out: Path) -> list[Path]:
     write_text(out / "paper_comparison.md", report_text(rs, summary, predict, trainings, optima))
     write_json(out / "headline.json", headline(summary, predict["networks"]))
     ids = ideas_settings(_view(cfg, "ideas"))
-    write_json(out / "ideas.json", ideas_summary({w: tables[w] for w in ("oracle", "regime")}, ids))
+    study = {w: tables[w] for w in ("oracle", "regime")}
+    write_json(out / "ideas.json", ideas_summary(study, ids, bundle_field(bundle, "free_cells")))
     write_text(out / "sampling_ideas.md", ideas_text(read_json(out / "ideas.json"), ids))
     names = ("summary.json", "paper_comparison.md", "headline.json", "ideas.json")
     return [out / n for n in (*names, "sampling_ideas.md")]
 
 
-def bundle_turns(bundle: Path) -> dict[int, int] | None:
-    """Each instance's turning points from the bundle's ``instances.json`` (None where the
-    bundle predates them: ``python -m vnrrt.pipeline.bundle_turns`` adds them)."""
+def bundle_field(bundle: Path, name: str) -> dict[int, int] | None:
+    """Per instance ``name`` (``turns``: turning points; ``free_cells``) from the bundle's
+    ``instances.json``; None where the bundle predates it (``python -m
+    vnrrt.pipeline.bundle_turns`` adds both)."""
     from vnrrt.infra.io import read_json
 
-    turns = read_json(bundle / "instances.json").get("turns")
-    return None if turns is None else {int(i): int(n) for i, n in turns.items()}
+    values = read_json(bundle / "instances.json").get(name)
+    return None if values is None else {int(i): int(n) for i, n in values.items()}
 
 
 def checked_tables(bundle: Path, es: dict, optima: dict) -> dict:

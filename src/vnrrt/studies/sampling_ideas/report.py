@@ -78,21 +78,44 @@ def _envelope_findings(summary: dict, stop: str, eps: float) -> list[str]:
     return out
 
 
+def _distinct(summary: dict) -> dict:
+    """The distinct cells' readings (:func:`~.summary.distinct_summary`), or every cell's
+    at the per-cell level where the summary has none."""
+    d = summary.get("distinct") or {}
+    if d.get("groups"):
+        return d
+    cells = summary.get("cell_names", [])
+    return {"groups": {c: [c] for c in cells}, "envelopes": summary["envelopes"],
+            "regime_claims": summary.get("regime_claims", []), "level": None}  # fmt: skip
+
+
 def cells_by_winner(summary: dict, stop: str, idea: str = "vertex") -> dict[str, list[str]]:
-    """``{"path": cells, idea: cells, "unclear": cells}``: the regime cells (in the study's
-    order) where the path envelope needs clearly fewer iterations than the ``idea`` envelope
-    (their paired ratio's CI below 1), where ``idea``'s needs clearly fewer (CI above 1), and
-    the others."""
+    """``{"path": cells, idea: cells, "unclear": cells}``: the distinct regime cells (in the
+    study's order; :mod:`.distinct`) where the path envelope needs clearly fewer iterations
+    than the ``idea`` envelope (their paired ratio's CI, corrected over the distinct cells,
+    below 1), where ``idea``'s needs clearly fewer (CI above 1), and the others."""
+    d = _distinct(summary)
     out: dict[str, list[str]] = {"path": [], idea: [], "unclear": []}
     rows = {
         r["regime"]: r["iterations"]
-        for r in summary["envelopes"]
+        for r in d["envelopes"]
         if r["stop"] == stop and r["idea"] == idea
     }
-    for cell in summary["cell_names"]:
+    for cell in d["groups"]:
         if cell in rows:
             out[_word(rows[cell], idea, "path", "unclear")].append(cell)
     return out
+
+
+def _corrected(summary: dict) -> str:
+    """How the per-cell counts were made: over distinct cells, Bonferroni-corrected."""
+    d = _distinct(summary)
+    if d["level"] is None:
+        return ""
+    same = [f"{' = '.join(cells)}" for cells in d["groups"].values() if len(cells) > 1]
+    merged = f"; the same runs: {'; '.join(same)}" if same else ""
+    return (f" (counted over {len(d['groups'])} distinct cells{merged}; each interval at "
+            f"{d['level']:.3%}, Bonferroni over the distinct cells)")  # fmt: skip
 
 
 def _winner_finding(summary: dict, stop: str, eps: float) -> list[str]:
@@ -108,7 +131,8 @@ def _winner_finding(summary: dict, stop: str, eps: float) -> list[str]:
         f"Path envelope against vertex envelope, per regime cell ({stop_name(stop, eps)}): "
         f"the path envelope needs clearly fewer iterations in {len(won['path'])} of {n} "
         f"cells{named(won['path'])}; the vertex envelope in {len(won['vertex'])}"
-        f"{named(won['vertex'])}; no clear difference in {len(won['unclear'])}."
+        f"{named(won['vertex'])}; no clear difference in {len(won['unclear'])}"
+        f"{_corrected(summary)}."
     ]
 
 
@@ -180,11 +204,12 @@ def conclusion(summary: dict) -> list[str]:
             f"{r['idea']} envelope's iterations saved ({stop_name('optimal', eps)})."
         )
     out += quality_needed(summary, eps)
-    for c in summary["regime_claims"]:
+    for c in _distinct(summary)["regime_claims"]:
         n = len(c["holds"]) + len(c["reversed"]) + len(c["unclear"])
         out.append(
             f"{c['claim']} ({stop_name(c['stop'], eps)}): holds in {len(c['holds'])} of "
-            f"{n} cells, reversed in {len(c['reversed'])}, unclear in {len(c['unclear'])}."
+            f"{n} distinct cells, reversed in {len(c['reversed'])}, unclear in "
+            f"{len(c['unclear'])}."
         )
     return out
 
