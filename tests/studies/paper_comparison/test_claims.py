@@ -42,7 +42,7 @@ def test_the_untestable_rule():
     ok = {"mass_endpoints": 0.3, "mass_interior": 0.2, "mass_path": 0.1, "fallback_rate": 0.1}
     assert masked_rule(ok, 0.5, 0.5) == {"testable": True, "why": ""}
     ends = masked_rule({**ok, "mass_endpoints": 0.984}, 0.5, 0.5)
-    assert not ends["testable"] and "98% of its sampler's mass is on the start/goal" in ends["why"]
+    assert not ends["testable"] and "98.4% of its sampler's mass is on the start" in ends["why"]
     falls = masked_rule({**ok, "fallback_rate": 1.0}, 0.5, 0.5)
     assert not falls["testable"] and "falls back to uniform sampling in 100%" in falls["why"]
     assert masked_rule(None, 0.5, 0.5)["testable"]  # not a masked claim

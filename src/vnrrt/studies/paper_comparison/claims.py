@@ -93,7 +93,7 @@ def testability(cell: dict | None, max_endpoints: float, max_fallback: float) ->
     why = []
     ends = cell.get("mass_endpoints")
     if ends is not None and ends > max_endpoints:
-        why.append(f"{ends:.0%} of its sampler's mass is on the start/goal disks")
+        why.append(f"{ends:.1%} of its sampler's mass is on the start/goal disks")
     if cell["fallback_rate"] > max_fallback:
         why.append(f"it falls back to uniform sampling in {cell['fallback_rate']:.0%} of trials")
     return {"testable": not why, "why": "; ".join(why)}
