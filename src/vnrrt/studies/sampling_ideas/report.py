@@ -78,15 +78,16 @@ def _envelope_findings(summary: dict, stop: str, eps: float) -> list[str]:
     return out
 
 
-def _distinct(summary: dict) -> dict:
-    """The distinct cells' readings (:func:`~.summary.distinct_summary`), or every cell's
-    at the per-cell level where the summary has none."""
-    d = summary.get("distinct") or {}
-    if d.get("groups"):
+def _distinct(summary: dict, stop: str) -> dict:
+    """A stop rule's distinct cells and their readings (:func:`~.summary.distinct_summary`),
+    or every cell's at the per-cell level where the summary has none."""
+    d = (summary.get("distinct") or {}).get("stops", {}).get(stop)
+    if d:
         return d
     cells = summary.get("cell_names", [])
+    claims = [c for c in summary.get("regime_claims", []) if c["stop"] == stop]
     return {"groups": {c: [c] for c in cells}, "envelopes": summary["envelopes"],
-            "regime_claims": summary.get("regime_claims", []), "level": None}  # fmt: skip
+            "regime_claims": claims, "level": None}  # fmt: skip
 
 
 def cells_by_winner(summary: dict, stop: str, idea: str = "vertex") -> dict[str, list[str]]:
@@ -94,7 +95,7 @@ def cells_by_winner(summary: dict, stop: str, idea: str = "vertex") -> dict[str,
     study's order; :mod:`.distinct`) where the path envelope needs clearly fewer iterations
     than the ``idea`` envelope (their paired ratio's CI, corrected over the distinct cells,
     below 1), where ``idea``'s needs clearly fewer (CI above 1), and the others."""
-    d = _distinct(summary)
+    d = _distinct(summary, stop)
     out: dict[str, list[str]] = {"path": [], idea: [], "unclear": []}
     rows = {
         r["regime"]: r["iterations"]
@@ -107,9 +108,9 @@ def cells_by_winner(summary: dict, stop: str, idea: str = "vertex") -> dict[str,
     return out
 
 
-def _corrected(summary: dict) -> str:
+def _corrected(summary: dict, stop: str) -> str:
     """How the per-cell counts were made: over distinct cells, Bonferroni-corrected."""
-    d = _distinct(summary)
+    d = _distinct(summary, stop)
     if d["level"] is None:
         return ""
     same = [f"{' = '.join(cells)}" for cells in d["groups"].values() if len(cells) > 1]
@@ -132,7 +133,7 @@ def _winner_finding(summary: dict, stop: str, eps: float) -> list[str]:
         f"the path envelope needs clearly fewer iterations in {len(won['path'])} of {n} "
         f"cells{named(won['path'])}; the vertex envelope in {len(won['vertex'])}"
         f"{named(won['vertex'])}; no clear difference in {len(won['unclear'])}"
-        f"{_corrected(summary)}."
+        f"{_corrected(summary, stop)}."
     ]
 
 
@@ -204,7 +205,10 @@ def conclusion(summary: dict) -> list[str]:
             f"{r['idea']} envelope's iterations saved ({stop_name('optimal', eps)})."
         )
     out += quality_needed(summary, eps)
-    for c in _distinct(summary)["regime_claims"]:
+    claims = [c for stop in OPTIMAL_STOPS for c in _distinct(summary, stop)["regime_claims"]]
+    pairs = list(dict.fromkeys((c["planner"], c["baseline"]) for c in claims))
+    claims.sort(key=lambda c: (pairs.index((c["planner"], c["baseline"])), c["stop"]))
+    for c in claims:
         n = len(c["holds"]) + len(c["reversed"]) + len(c["unclear"])
         out.append(
             f"{c['claim']} ({stop_name(c['stop'], eps)}): holds in {len(c['holds'])} of "

@@ -254,25 +254,31 @@ def regime_claims(rows: list[dict], pairs: list[tuple[str, str]], table, boot) -
 
 def distinct_summary(ev: pd.DataFrame, study: dict, envelopes: dict, pairs: list, settings: dict,
                      free: dict[int, int] | None) -> dict:  # fmt: skip
-    """The regime cells counted once per distinct setting (:mod:`.distinct`): ``groups``
-    (representative -> cells), and the envelope comparisons and claims of the
+    """Per optimal stop rule, the regime cells counted once per distinct setting
+    (:mod:`.distinct`, from that stop's runs of the configurations every cell ran):
+    ``groups`` (representative -> cells), and the envelope comparisons and claims of the
     representatives at the Bonferroni level over the distinct cells (``level``), from enough
     resamples that each tail holds ``settings["tail_draws"]`` draws (``bootstrap``)."""
     cells = {d.PROTOCOL: study["protocol"], **d.regime_cells(study["regime"], study["protocol"])}
-    found = groups(effective_keys(ev, _settings_of(cells, ev), free))
-    strict = 1.0 - (1.0 - float(settings["level"])) / max(len(found), 1)
+    settings_of = _settings_of(cells, ev)
+    shared = set.intersection(*(set(t["key"]) for _, t in ev.groupby("regime", sort=False)))
     tails = int(settings.get("tail_draws", 1))
-    boot = (max(int(settings["bootstrap"]), math.ceil(tails / ((1 - strict) / 2) - 1e-6)), strict)
-    reps = ev[ev["regime"].isin(found)]
-    rows = [{"regime": c} for c in found]
-    return {
-        "groups": found,
-        "level": strict,
-        "bootstrap": boot[0],
-        "free_cells": free is not None,
-        "envelopes": envelope_rows(reps, envelopes, boot) if len(reps) else [],
-        "regime_claims": regime_claims(rows, pairs, reps, boot) if len(reps) else [],
-    }
+    out = {"free_cells": free is not None, "stops": {}}
+    for stop in ("optimal", "optimal_any_angle"):
+        runs = ev[ev["stop"] == stop]
+        if runs.empty:
+            continue
+        found = groups(effective_keys(runs[runs["key"].isin(shared)], settings_of, free))
+        strict = 1.0 - (1.0 - float(settings["level"])) / max(len(found), 1)
+        n_boot = max(int(settings["bootstrap"]), math.ceil(tails / ((1 - strict) / 2) - 1e-6))
+        reps = runs[runs["regime"].isin(found)]
+        rows, boot = [{"regime": c} for c in found], (n_boot, strict)
+        out["stops"][stop] = {
+            "groups": found, "level": strict, "bootstrap": n_boot,
+            "envelopes": envelope_rows(reps, envelopes, boot),
+            "regime_claims": regime_claims(rows, pairs, reps, boot),
+        }  # fmt: skip
+    return out
 
 
 def _settings_of(cells: dict, ev: pd.DataFrame) -> dict:
