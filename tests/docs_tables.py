@@ -62,9 +62,19 @@ def headline_table(reports: Path = REPORTS) -> str:
     ]
     for row in markdown_table(text, "The paper's quoted claims"):
         ours = row["ours: time, gm ratio of medians [CI]"]
-        rows.append(f"| {row['claim']} | {row['paper']} | {ours} | {row['verdict']} |")
+        verdict = row["verdict"]
+        if row.get("tests the mask?", "yes").startswith("no"):
+            verdict += "; untestable with this network"
+        rows.append(f"| {row['claim']} | {row['paper']} | {ours} | {verdict} |")
+    head = json.loads((reports / "metrics" / "headline.json").read_text())
     total = ", ".join(f"{VERDICT_WORDS[k]} {counts[k]}" for k in VERDICTS)
-    return "\n".join(rows) + f"\n\nVerdicts: {total}.\n"
+    untestable = head.get("untestable", 0)
+    if not untestable:
+        return "\n".join(rows) + f"\n\nVerdicts: {total}.\n"
+    return "\n".join(rows) + (
+        f"\n\nVerdicts of the {head['testable']} testable claims: {total}; "
+        f"{untestable} untestable with this network (no verdict counted).\n"
+    )
 
 
 def oracle_table(reports: Path = REPORTS) -> str:
@@ -90,9 +100,19 @@ def oracle_table(reports: Path = REPORTS) -> str:
         "blend": "both (blend)",
         "control": "start and goal only",
     }
+    edge = False
     for idea, name in names.items():
-        rows.append(f"| {name} | " + " | ".join(found[idea][s] for s in stops) + " |")
-    return "\n".join(rows) + "\n"
+        cells = []
+        for s in stops:
+            value, flagged, _ = found[idea][s].partition(" (best measured member: ")
+            edge |= bool(flagged)
+            cells.append(value + (" †" if flagged else ""))
+        rows.append(f"| {name} | " + " | ".join(cells) + " |")
+    note = (
+        "\n† the best measured member of its family: its heatmap-draw probability or blur "
+        "is the largest or smallest value the grid tried, so it is no bound of its idea.\n"
+    )
+    return "\n".join(rows) + "\n" + (note if edge else "")
 
 
 def networks_table(reports: Path = REPORTS) -> str:

@@ -57,6 +57,8 @@ CHANGED = {  # key -> a valid value other than the default's
     "stats.tail_draws": 20,
     "stats.untestable_endpoint_share": 0.7,
     "stats.untestable_fallback": 0.6,
+    "stats.strata": [0, 2, 5],
+    "stats.pairing": [0.3],
     "oracle.families": {  # Hydra merges a dict override into the default: every key given
         "path": ["oracle_path"],
         "vertex": ["oracle_vertex"],

@@ -191,7 +191,9 @@ def test_smoke_dvc_repro_end_to_end(workdir, tracking_server):
         assert text in ideas, text
     assert (workdir / "reports/figures/ideas/quality_curve.png").stat().st_size > 10_000
     headline = json.loads((workdir / "reports/metrics/headline.json").read_text())
-    assert sum(headline["verdicts"].values()) == 8  # one verdict per claim
+    # one verdict per testable claim; an untestable claim gets none in the counts
+    assert sum(headline["verdicts"].values()) + headline["untestable"] == 8
+    assert headline["testable"] == sum(headline["verdicts"].values())
     client = MlflowClient(f"sqlite:///{workdir / 'mlflow.db'}")
     exp = client.get_experiment_by_name("vnrrt-smoke")
     runs = client.search_runs([exp.experiment_id])

@@ -148,6 +148,18 @@ class Instances:
             }
         return out
 
+    def turns(self) -> dict[int, int]:
+        """``{instance: turning points}``: the interior vertices of each exact optimum
+        (``exact_points`` holds start and goal too)."""
+        counts = np.diff(self.arrays["exact_offsets"]) - 2
+        return {i: int(c) for i, c in enumerate(counts)}
+
+    def free_cells(self) -> dict[int, int]:
+        """``{instance: free cells}`` of each instance's map (its RRT* gamma's area)."""
+        grids = self.arrays["grids"]
+        occupied = np.unpackbits(grids, axis=-1, count=self.size).reshape(len(grids), -1).sum(1)
+        return {i: int(self.size * self.size - o) for i, o in enumerate(occupied)}
+
     def named(self) -> dict[str, str]:
         """``{map_set: name}`` of the named maps (``map_1``: ``open_room``, ...)."""
         a = self.arrays

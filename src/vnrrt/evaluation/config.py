@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from itertools import pairwise
 
 from vnrrt.config import ConfigError, check, check_parts, conf_defaults
 from vnrrt.evaluation.keys import MASK_VARIANTS, ConfigKey
@@ -127,6 +128,8 @@ class StatsConfig:
     tail_draws: int  # bootstrap draws in each tail at the claims' corrected level
     untestable_endpoint_share: float  # a masked sampler with more on start/goal ...
     untestable_fallback: float  # ... or falling back to uniform more often: untestable
+    strata: list[int]  # lower bounds of the turning-point strata (vnrrt.evaluation.strata)
+    pairing: list[float]  # correlations between the paper's planners: its interval's sensitivity
 
     def validate(self) -> None:
         if not isinstance(self.bootstrap, int) or self.bootstrap < 100:
@@ -138,6 +141,12 @@ class StatsConfig:
         for name in ("untestable_endpoint_share", "untestable_fallback"):
             v = getattr(self, name)
             check(0 < v <= 1, f"stats.{name}", v, "must be in (0, 1]")
+        b = self.strata
+        ok = bool(b) and all(isinstance(v, int) for v in b) and b[0] == 0
+        ok = ok and all(x < y for x, y in pairwise(b))
+        check(ok, "stats.strata", b, "increasing integers from 0 (turning points)")
+        ok = all(0 < r < 1 for r in self.pairing)
+        check(ok, "stats.pairing", self.pairing, "every correlation must be in (0, 1)")
 
 
 @dataclass

@@ -50,7 +50,7 @@ def run_evaluate(cfg: DictConfig) -> dict:
     design = design_of(inst, rules.eps, rules.max_iterations, s["seed"], keys)
     table = merge_parts(paths.trials, ev.parts, sum(j.count for j in jobs), design)
     write_table(table, paths.trials_table)
-    summary = evaluate_summary(table, s, read_json(paths.predict_metrics))
+    summary = evaluate_summary(table, s, read_json(paths.predict_metrics), inst.turns())
     write_json(paths.summary, summary)
     curves = convergence_curves(table, rules.eps)
     write_text(paths.convergence, curves.to_csv(index=False))
@@ -59,17 +59,17 @@ def run_evaluate(cfg: DictConfig) -> dict:
     return summary
 
 
-def evaluate_summary(table, s: dict, predict: dict) -> dict:
+def evaluate_summary(table, s: dict, predict: dict, turns: dict[int, int] | None) -> dict:
     """The summary of the merged trial ``table``
     (:func:`~vnrrt.studies.paper_comparison.summary.analyze`) with stage
-    ``evaluate``'s settings ``s`` and the networks' inference times of ``predict``
-    (``predict.json``)."""
+    ``evaluate``'s settings ``s``, the networks' inference times of ``predict``
+    (``predict.json``) and each instance's turning points ``turns`` (None: no strata)."""
     from vnrrt.studies.paper_comparison.summary import analyze
     from vnrrt.studies.paper_tables import load_paper_tables
 
     paper = load_paper_tables(s["paths"].paper_tables)
     inference = {n: float(m["ms_per_map"]) for n, m in predict["networks"].items()}
-    return analyze(table, paper, s["planner"].eps, s["stats"], inference)
+    return analyze(table, paper, s["planner"].eps, s["stats"], inference, turns)
 
 
 def series_per_map_set(curves) -> dict:

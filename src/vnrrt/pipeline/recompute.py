@@ -29,7 +29,8 @@ BUNDLE = {  # file -> what it holds
     "trials.csv.gz": "the paper comparison's trials, one row per planner run",
     "oracle.csv.gz": "the oracle study's trials",
     "regime.csv.gz": "the regime sweep's trials",
-    "instances.json": "per map set the A*, exact and taut optimal lengths; the named maps",
+    "instances.json": "per map set the A*, exact and taut optimal lengths; the named maps; "
+    "each instance's turning points (the strata) and free cells (the distinct regime cells)",
     "predict.json": "the networks' heatmap metrics, inference times and their settings",
     "train.json": "each network's training metrics (steps, images, time, architecture; with "
     "eval.gpu also the GPU-trained networks')",
@@ -61,7 +62,10 @@ def export(params: Path, out: Path) -> list[Path]:
         _gzip(out / f"{which}.csv", out / f"{which}.csv.gz")
         (out / f"{which}.csv").unlink()
     inst = Instances(paths.instances)
-    write_json(out / "instances.json", {"optima": inst.optima(), "named": inst.named()})
+    turns = {str(i): n for i, n in inst.turns().items()}
+    free = {str(i): n for i, n in inst.free_cells().items()}
+    write_json(out / "instances.json", {"optima": inst.optima(), "named": inst.named(),
+                                        "turns": turns, "free_cells": free})  # fmt: skip
     predict = read_json(paths.predict_metrics)
     write_json(out / "predict.json", predict)
     trainings = {n: read_json(paths.train_metrics(n)) for n in predict["networks"]}
@@ -127,7 +131,7 @@ def recompute(bundle: Path, out: Path) -> list[Path]:
     es = evaluate_settings(_view(cfg, "evaluate"))
     tables = checked_tables(bundle, es, read_json(bundle / "instances.json")["optima"])
     out.mkdir(parents=True, exist_ok=True)
-    summary = evaluate_summary(tables["trials"], es, predict)
+    summary = evaluate_summary(tables["trials"], es, predict, bundle_field(bundle, "turns"))
     write_json(out / "summary.json", summary)
     summary = read_json(out / "summary.json")  # as the report stage reads it
     rs = report_settings(_view(cfg, "report"))
@@ -137,10 +141,21 @@ def recompute(bundle: Path, out: Path) -> list[Path]:
     tau = float(cfg.planner.tau)
     write_json(out / "headline.json", headline(summary, predict["networks"], tau, machine))
     ids = ideas_settings(_view(cfg, "ideas"))
-    write_json(out / "ideas.json", ideas_summary({w: tables[w] for w in ("oracle", "regime")}, ids))
+    study = {w: tables[w] for w in ("oracle", "regime")}
+    write_json(out / "ideas.json", ideas_summary(study, ids, bundle_field(bundle, "free_cells")))
     write_text(out / "sampling_ideas.md", ideas_text(read_json(out / "ideas.json"), ids))
     names = ("summary.json", "paper_comparison.md", "headline.json", "ideas.json")
     return [out / n for n in (*names, "sampling_ideas.md")]
+
+
+def bundle_field(bundle: Path, name: str) -> dict[int, int] | None:
+    """Per instance ``name`` (``turns``: turning points; ``free_cells``) from the bundle's
+    ``instances.json``; None where the bundle predates it (``python -m
+    vnrrt.pipeline.bundle_turns`` adds both)."""
+    from vnrrt.infra.io import read_json
+
+    values = read_json(bundle / "instances.json").get(name)
+    return None if values is None else {int(i): int(n) for i, n in values.items()}
 
 
 def checked_tables(bundle: Path, es: dict, optima: dict) -> dict:

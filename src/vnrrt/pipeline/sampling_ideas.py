@@ -216,23 +216,24 @@ def ideas_tables(settings: dict) -> dict:
     return {"oracle": oracle, "regime": regime}
 
 
-def ideas_summary(tables: dict, settings: dict) -> dict:
+def ideas_summary(tables: dict, settings: dict, free: dict[int, int] | None = None) -> dict:
     """The study's statistics (:func:`~vnrrt.studies.sampling_ideas.summary.analyze_study`) of the
-    merged ``tables``
-    with stage ``ideas``'s settings, which the summary records (``settings``)."""
+    merged ``tables`` with stage ``ideas``'s settings, which the summary records
+    (``settings``), and each instance's free cells ``free`` (the distinct-cell rule)."""
     from vnrrt.infra.io import read_json
     from vnrrt.studies.paper_tables import claim_pairs, load_paper_tables
     from vnrrt.studies.sampling_ideas.summary import analyze_study, as_json
 
     st, rules, stats = _study(settings), settings["planner"], settings["stats"]
     pairs = claim_pairs(load_paper_tables(st.paths.paper_tables))
-    shown = {"eps": rules.eps, "level": stats.level, "bootstrap": stats.bootstrap}
+    shown = {"eps": rules.eps, "level": stats.level, "bootstrap": stats.bootstrap,
+             "tail_draws": stats.tail_draws}  # fmt: skip
     shown |= {"radius": st.oracle.radius, "floor": st.oracle.floor}
     shown |= {"zero_obstacles": st.ev.zero_obstacles, "selection_share": st.oracle.selection_share}
     predict = read_json(st.paths.predict_metrics)["networks"]
     study = {"oracle": st.oracle, "regime": st.regime, "ev": st.ev, "protocol": st.protocol,
              "targets": {n: m["target"] for n, m in predict.items()}}  # fmt: skip
-    return as_json(analyze_study(tables, study, pairs, shown))
+    return as_json(analyze_study(tables, study, pairs, shown, free))
 
 
 def ideas_text(summary: dict, settings: dict) -> str:
@@ -249,6 +250,7 @@ def ideas_text(summary: dict, settings: dict) -> str:
 
 def run_ideas(cfg: DictConfig) -> dict:
     """Stage ``ideas`` (module doc); returns the summary."""
+    from vnrrt.data.instances import Instances
     from vnrrt.infra.io import read_json, write_json, write_text
     from vnrrt.tracking import store as tracking
 
@@ -256,7 +258,8 @@ def run_ideas(cfg: DictConfig) -> dict:
     logger, paths = settings["logger"], settings["paths"]
     if logger.enabled:  # an unreachable store fails here, before any work
         tracking.check_store(tracking.tracking_uri(logger.uri))
-    write_json(paths.ideas_summary, ideas_summary(ideas_tables(settings), settings))
+    free = Instances(paths.instances).free_cells()
+    write_json(paths.ideas_summary, ideas_summary(ideas_tables(settings), settings, free))
     summary = read_json(paths.ideas_summary)  # what every reader sees: the file's numbers
     written = save_figures(paths, summary)
     write_text(paths.ideas_report, ideas_text(summary, settings))

@@ -96,7 +96,10 @@ def test_cells_show_censoring_and_fallbacks():
 def test_report_on_a_synthetic_table(repo):
     paper = load_paper_tables(repo / "data/paper/tables.yaml")
     st = StatsConfig(bootstrap=300, level=0.95)
-    summary = analyze(synthetic_trials(), paper, 0.01, st, {"vertexnet": 15.0, "nrrtnet": 14.0})
+    turns = {i: i % 5 for i in range(21)}  # random 1..20: 4 of 0, 8 of 1-2, 8 of 3+
+    summary = analyze(synthetic_trials(), paper, 0.01, st, {"vertexnet": 15.0, "nrrtnet": 14.0},
+                      turns)  # fmt: skip
+    assert summary["strata"]["random"] == {"line of sight": 4, "1-2 turns": 8, "3+ turns": 8}
     optima = {"map_1": {"astar": 110.0, "exact": 100.0, "taut": 101.0}}
     settings = yaml.safe_load((repo / "data/paper/settings.yaml").read_text())
     values = {e["key"]: 0.5 for e in settings["settings"] if e.get("key")}
@@ -144,6 +147,13 @@ def test_report_on_a_synthetic_table(repo):
     }
     vn = rows["vnrrt_star"]["time_to_stop"]
     assert 1.6 < vn["speedup"] < 2.4 and vn["instances"] == 20 and vn["clusters"] == 10
+    per = rows["vnrrt_star"]["strata"]
+    assert [per[n]["instances"] for n in ("line of sight", "1-2 turns", "3+ turns")] == [4, 8, 8]
+    assert "### The claims per turning-point stratum" in text
+    assert "| 3+ turns | 0 | 8 |" in text  # the mix: map_1 (0 turns) and the random maps
+    assert "The paper's mix is unknown for its random maps" in text
+    assert "### Each claim under both estimands" in text and "robustness" in text
+    assert "paired, correlation 0.9" in text
 
 
 def test_networks_table_shows_shares_and_multiples_of_uniform():

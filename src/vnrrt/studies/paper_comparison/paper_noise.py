@@ -43,14 +43,19 @@ class PaperInterval:
 
 
 def ratio_interval(baseline: tuple[float, float, int], planner: tuple[float, float, int],
-                   level: float) -> PaperInterval:  # fmt: skip
+                   level: float, rho: float = 0.0) -> PaperInterval:  # fmt: skip
     """The delta-method interval (module doc) of ``mean_b / mean_p - 1``; ``baseline`` and
-    ``planner`` are ``(mean, sd, n)``."""
+    ``planner`` are ``(mean, sd, n)``. ``rho`` > 0: the sensitivity to pairing, as if the
+    two planners' times on the same map were correlated ``rho`` (the covariance term
+    ``- 2 rho sqrt(a b)`` of ``Var(log R) = a + b``, ``a = s_b^2 / (n_b m_b^2)``, ``b`` the
+    planner's); 0, the paper's unpaired reading."""
     (mb, sb, nb), (mp, sp, np_) = baseline, planner
-    if min(mb, mp) <= 0 or min(nb, np_) < 2 or min(sb, sp) < 0:
-        raise ValueError(f"need positive means, n >= 2, sd >= 0: {baseline}, {planner}")
+    if min(mb, mp) <= 0 or min(nb, np_) < 2 or min(sb, sp) < 0 or not 0 <= rho < 1:
+        raise ValueError(f"need positive means, n >= 2, sd >= 0, 0 <= rho < 1: {baseline}, "
+                         f"{planner}, rho={rho}")  # fmt: skip
     log_r = math.log(mb) - math.log(mp)
-    se = math.sqrt(sb**2 / (nb * mb**2) + sp**2 / (np_ * mp**2))
+    a, b = sb**2 / (nb * mb**2), sp**2 / (np_ * mp**2)
+    se = math.sqrt(a + b - 2 * rho * math.sqrt(a * b))
     z = float(norm.ppf(0.5 + level / 2))
     return PaperInterval(
         math.exp(log_r) - 1,
@@ -90,9 +95,10 @@ def paper_cell(paper: dict, table: str, key: str, column: str) -> tuple[float, f
     return float(mean), float(sd), int(n)
 
 
-def claim_interval(paper: dict, claim: dict, level: float) -> PaperInterval:
-    """The paper's interval of one quoted claim (``tables.yaml``'s ``claims`` entry)."""
+def claim_interval(paper: dict, claim: dict, level: float, rho: float = 0.0) -> PaperInterval:
+    """The paper's interval of one quoted claim (``tables.yaml``'s ``claims`` entry), its
+    planners correlated ``rho`` (:func:`ratio_interval`; 0: unpaired, the paper's design)."""
     table, column = claim["table"], claim["column"]
     base = paper_cell(paper, table, claim["baseline"], column)
     plan = paper_cell(paper, table, claim["planner"], column)
-    return ratio_interval(base, plan, level)
+    return ratio_interval(base, plan, level, rho)

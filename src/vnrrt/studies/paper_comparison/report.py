@@ -19,6 +19,11 @@ from vnrrt.names import MAP_SET_NAMES as COLUMN_NAMES
 from vnrrt.names import level_name, percent, stop_title
 from vnrrt.studies.paper_comparison.claims import CONTRADICTS, verdict_text
 from vnrrt.studies.paper_comparison.claims import improvement as _imp
+from vnrrt.studies.paper_comparison.claims_report import (
+    difference_table,
+    estimand_table,
+    strata_section,
+)
 from vnrrt.studies.paper_comparison.disclosure import (
     mask_section,
     networks_scale_table,
@@ -56,11 +61,12 @@ HEADLINE_PLANNERS = {"rrt_star": "rrt", "nrrt_star": "nrrt", "vnrrt_star": "vnrr
 def headline(summary: dict, networks: dict, tau: float, machine: str | None = None) -> dict:
     """The few numbers of ``dvc metrics show`` (one line each under ~300 characters in a
     terminal; the full tables are in the report and MLflow): the counts of verdicts on the
-    paper's claims, each network's mass near what it is for (a vertex network: the interior
-    vertices; a path network: the path) as a multiple of a uniform map's, the vertex
-    networks' interior-vertex AP, the median planning time (ms) to the A*-relative optimum
-    on random maps of RRT*, NRRT*, VNRRT* and M-VNRRT* at ``tau`` (``planner.tau``), and
-    the ``machine`` whose timings these are (None: not recorded). ``networks``:
+    paper's testable claims (an untestable claim gets no verdict in the counts), each
+    network's mass near what it is for (a vertex network: the interior vertices; a path
+    network: the path) as a multiple of a uniform map's, the vertex networks'
+    interior-vertex AP, the median planning time (ms) to the A*-relative optimum on random
+    maps of RRT*, NRRT*, VNRRT* and M-VNRRT* at ``tau`` (``planner.tau``), and the
+    ``machine`` whose timings these are (None: not recorded). ``networks``:
     ``predict.json``'s metrics per network."""
     out: dict = {"verdicts": {}, "mass_x": {}, "opt_ms": {}, "interior_ap": {}}
     for net, m in networks.items():
@@ -78,12 +84,13 @@ def headline(summary: dict, networks: dict, tau: float, machine: str | None = No
         protocol = ConfigKey(key.planner, tau if key.planner == "m_vnrrt_star" else None)
         if s is not None and key == protocol:
             out["opt_ms"][HEADLINE_PLANNERS[key.planner]] = round(1e3 * s["median"], 3)
-    rows = summary["claims"]["rows"]
-    verdicts = [r["verdict"] for r in rows if r["time_to_stop"]]  # one verdict per claim
+    rows = [r for r in summary["claims"]["rows"] if r["time_to_stop"]]
+    testable = [r for r in rows if r["testability"]["testable"]]
+    verdicts = [r["verdict"] for r in testable]  # one per testable claim; untestable: none
     for group in VERDICT_GROUPS:
         out["verdicts"][VERDICT_KEYS[group]] = sum(v.startswith(group) for v in verdicts)
-    out["testable"] = sum(r["testability"]["testable"] for r in rows if r["time_to_stop"])
-    out["contradicting"] = sum(r["paper_data"] == CONTRADICTS for r in rows)
+    out["testable"], out["untestable"] = len(testable), len(rows) - len(testable)
+    out["contradicting"] = sum(r["paper_data"] == CONTRADICTS for r in testable)
     return out | ({"machine": machine} if machine else {})
 
 
@@ -214,6 +221,8 @@ def multiple_note(claims: dict) -> str:
     """How the claims were tested: the corrected level, the resamples and their tail count,
     and which claims are significant in the paper's own data."""
     rows = [r for r in claims["rows"] if r["time_to_stop"]]
+    testable = [r for r in rows if r["testability"]["testable"]]
+    contra = sum(r["paper_data"] == CONTRADICTS for r in testable)
     slow = sum(r["quoted"] < 0 for r in claims["rows"])
     sig = [r["text"] for r in claims["rows"] if r["paper"]["significant"]]
     return (
@@ -224,13 +233,17 @@ def multiple_note(claims: dict) -> str:
         f"{claims['claims']} claims: family-wise {level_name(claims['level'])}), ours from "
         f"{claims['bootstrap']:,} bootstrap resamples ({claims['tail_draws']:.0f} in each tail). "
         "The paper's interval comes from its own means, standard deviations and trial counts "
-        "(the delta method on the log of a ratio of independent means: its planners were not "
-        "paired); '(n.s.)' marks a claim whose interval contains zero, not significant in the "
-        "paper's own data. Our ratio of means (the paper's estimand) is 'compatible with the "
-        "paper's data' when the two intervals overlap, and 'contradicts' it when they do not. "
+        "(the delta method on the log of a ratio of independent means: it assumes its planners "
+        "unpaired, as its tables report them; its sensitivity to pairing is below); '(n.s.)' "
+        "marks a claim whose interval contains zero, not significant in the paper's own data. "
+        "Our ratio of means (the paper's estimand) is 'compatible with the paper's data' when "
+        "the interval of the difference between ours and the paper's contains no difference, "
+        "and 'contradicts' it when it does not. "
         f"Significant in the paper's own data: {len(sig)} of {len(claims['rows'])}"
         + (f" ({'; '.join(sig)})." if sig else ".")
-        + f" Verdicts here: {_counts([r['verdict'] for r in rows])}."
+        + f" Verdicts of the {len(testable)} testable claims: "
+        f"{_counts([r['verdict'] for r in testable])}; {len(rows) - len(testable)} untestable "
+        f"(no verdict counted); {contra} testable claims contradict the paper's data."
     )
 
 
@@ -305,9 +318,12 @@ RULES = """How to read the tables:
   instance. The paper's ratio of means is shown beside it.
 - Verdicts (one per claim, on time; at the claims' corrected level): "reproduced" = same sign
   and the paper's value inside our CI; "same direction, smaller/larger effect" = the CI
-  excludes zero on the paper's side but not its value; "no clear effect" = the CI contains
-  zero; "reversed" = the CI excludes zero on the other side. Beside it, against the paper's
-  own interval: "compatible with the paper's data" or "contradicts the paper's data".
+  excludes zero on the paper's side, not the paper's value, and the interval of the
+  difference between ours and the paper's (both noises) excludes no difference; "same
+  direction, size within the paper's noise" = as before but the difference interval contains
+  no difference; "no clear effect" = the CI contains zero; "reversed" = the CI excludes zero
+  on the other side. Beside it, by the interval of the difference between our ratio of means
+  and the paper's: "compatible with the paper's data" or "contradicts the paper's data".
 - Our named maps are our own (built to the paper's difficulty ordering, not to its
   geometry, which the paper does not give), so claims on Maps 1-5 are marked "different map:
   not comparable"; the random-maps column is the comparable one."""
@@ -452,6 +468,26 @@ def build_report(inp: ReportInputs) -> str:
         "",
         multiple_note(summary["claims"]),
         "",
+        "### Each claim under both estimands",
+        "",
+        "The paper's estimand (ratio of means) and ours (geometric mean of per-instance ratios "
+        "of medians), each on planning time and on iterations, at the claims' corrected level; "
+        "the verdict is the first reading's, and the robustness column says whether every "
+        "other reading gives the same category, or which moves it.",
+        "",
+        estimand_table(summary["claims"]),
+        "",
+        "### Against the paper's own data: the interval of the difference",
+        "",
+        "Our ratio of means and the paper's, compared by the interval of their ratio (ours / "
+        "paper: a difference on the log scale, the two standard errors combined as "
+        "independent samples). The paper's interval assumes its planners unpaired; had they "
+        "run on the same maps with correlated times, its interval would be narrower "
+        "(correlation columns; `stats.pairing`).",
+        "",
+        difference_table(summary["claims"]),
+        "",
+        *strata_section(summary, cols, COLUMN_NAMES),
         *masked_claims_section(summary),
         *timing_section(summary, inp.changes, inp.overrides),
         "## Settings: this run beside the paper",

@@ -14,6 +14,7 @@ from vnrrt.evaluation.keys import ConfigKey
 from vnrrt.evaluation.noise import timing_noise
 from vnrrt.evaluation.protocol import STOPS
 from vnrrt.evaluation.stats import Summary, compare, summarize
+from vnrrt.evaluation.strata import assign, mix
 from vnrrt.evaluation.table import CONVERGENCE_COLUMNS, CONVERGENCE_FACTORS
 from vnrrt.studies.paper_comparison.claims import claims, mask_shares
 
@@ -129,17 +130,25 @@ def with_inference(table: pd.DataFrame, inference_ms: dict[str, float]) -> pd.Da
 
 
 def analyze(
-    table: pd.DataFrame, paper: dict, eps: float, st, inference_ms: dict[str, float]
+    table: pd.DataFrame,
+    paper: dict,
+    eps: float,
+    st,
+    inference_ms: dict[str, float],
+    turns: dict[int, int] | None = None,
 ) -> dict:
     """The whole summary (module doc) of a merged trial table, with the settings its numbers
     were computed with (stop tolerance ``eps``; ``st``, the ``stats`` section: resamples, CI
-    level, claim rules); ``inference_ms``: each network's inference per map (ms)."""
+    level, claim rules, strata); ``inference_ms``: each network's inference per map (ms);
+    ``turns``: each instance's turning points (:mod:`vnrrt.evaluation.strata`; None: no
+    strata)."""
     n_boot, level = st.bootstrap, st.level
     stops = [s for s in STOPS if s in set(table["stop"])]
     keys = list(dict.fromkeys(table["key"]))
     shares = mask_shares(table)
     timed = with_inference(table, inference_ms)
-    judged = claims(timed, paper, st, shares)
+    strata = None if turns is None else assign(turns, st.strata)
+    judged = claims(timed, paper, st, shares, strata)
     noise = timing_noise(table, judged["bootstrap"], judged["corrected_level"])
     return {
         "eps": eps,
@@ -160,6 +169,7 @@ def analyze(
             for m in ("time_to_stop", "iterations")
         },
         "claims": judged,
+        "strata": {} if strata is None else mix(table, strata, st.strata),
         "informed": informed_comparisons(table, n_boot, level),
         "setup_ms": {
             k: float(1e3 * sub["setup_time"].median())

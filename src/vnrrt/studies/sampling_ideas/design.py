@@ -31,6 +31,7 @@ from vnrrt.evaluation.config import Configurations, OracleConfig, RegimeConfig
 from vnrrt.evaluation.keys import ConfigKey
 from vnrrt.evaluation.oracles import BLEND, OracleSource
 from vnrrt.evaluation.protocol import STOPS
+from vnrrt.studies.sampling_ideas.distinct import cell_key
 
 PROTOCOL = "protocol"  # the regime cell of the protocol's own planner settings
 IDEA_PLANNER = {"path": "nrrt_star"}  # path oracles are NRRT*'s idea; the others VNRRT*'s
@@ -179,9 +180,11 @@ def regime_cells(rc: RegimeConfig, protocol: dict) -> dict[str, dict]:
     ``eta=5 radius=shrinking*0.1 goal=inf``: ``{"eta": 5.0, "radius_mode": "shrinking",
     "gamma_factor": 0.1, "goal_radius": inf}``. Left out: an unlimited step with a fixed
     radius (every node near), and the cell whose overrides all equal ``protocol``'s settings
-    (:func:`protocol_settings`): it would repeat the protocol cell's runs exactly (the same
-    seeds; the study's counts would count that setting twice)."""
-    cells = {}
+    (:func:`protocol_settings`), and a cell whose effective settings
+    (:func:`~vnrrt.studies.sampling_ideas.distinct.cell_key`: the goal radius is moot at an
+    unlimited step) equal the protocol's or an earlier cell's: it would repeat those runs
+    exactly (the same seeds; the study's counts would count that setting twice)."""
+    cells, seen = {}, {cell_key(protocol)}
     for eta in rc.etas:
         for name, rule in radius_rules(rc):
             over = dict(rule)
@@ -193,6 +196,22 @@ def regime_cells(rc: RegimeConfig, protocol: dict) -> dict[str, dict]:
                 goal_label = "eta" if goal is None else f"{goal:g}"
                 g = None if goal is None else float(goal)
                 cell = {"eta": float(eta), "goal_radius": g, **over}
-                if any(protocol[k] != v for k, v in cell.items()):
+                if cell_key(cell) not in seen:
+                    seen.add(cell_key(cell))
                     cells[f"eta={eta:g} radius={name} goal={goal_label}"] = cell
     return cells
+
+
+def cell_of_label(label: str) -> dict:
+    """The overrides of a regime cell from its label (:func:`regime_cells`' form, e.g.
+    ``eta=5 radius=shrinking*0.5 goal=inf``); ``ValueError`` naming a label of another form."""
+    try:
+        parts = dict(item.split("=", 1) for item in label.split(" "))
+        eta, name, goal = float(parts["eta"]), parts["radius"], parts["goal"]
+    except (KeyError, ValueError):
+        raise ValueError(f"{label!r} is not a regime cell label (eta= radius= goal=)") from None
+    cell = {"eta": eta, "goal_radius": None if goal == "eta" else float(goal)}
+    if name.startswith("fixed"):
+        return cell | {"radius_mode": "fixed", "fixed_radius": eta * int(name[len("fixed") :])}
+    factor = float(name.split("*")[1]) if "*" in name else 1.0
+    return cell | {"radius_mode": "shrinking", "gamma_factor": factor}

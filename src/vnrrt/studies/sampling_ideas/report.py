@@ -12,6 +12,7 @@ import math
 from vnrrt.evaluation.keys import ConfigKey, label
 from vnrrt.names import level_name, percent, stop_name
 from vnrrt.studies.sampling_ideas.design import PROTOCOL
+from vnrrt.studies.sampling_ideas.edges import edge_note
 from vnrrt.studies.sampling_ideas.summary import sweep_columns
 
 IDEAS = ("path", "vertex", "blend", "control")
@@ -59,7 +60,9 @@ def _envelope_findings(summary: dict, stop: str, eps: float) -> list[str]:
     }
     out = []
     cells = {i: _cell(summary, PROTOCOL, stop, env.get(i)) for i in IDEAS}
-    said = "; ".join(f"{i} {_x((cells[i] or {}).get('iterations'))}" for i in IDEAS if cells[i])
+    edges = summary["selection"].get("edges", {}).get(stop, {})
+    said = "; ".join(f"{i} {_x((cells[i] or {}).get('iterations'))}{edge_note(edges.get(i))}"
+                     for i in IDEAS if cells[i])  # fmt: skip
     if said:
         out.append(
             f"Envelopes ({stop_name(stop, eps)}, the protocol's cell, fewer iterations "
@@ -75,21 +78,45 @@ def _envelope_findings(summary: dict, stop: str, eps: float) -> list[str]:
     return out
 
 
+def _distinct(summary: dict, stop: str) -> dict:
+    """A stop rule's distinct cells and their readings (:func:`~.summary.distinct_summary`),
+    or every cell's at the per-cell level where the summary has none."""
+    d = (summary.get("distinct") or {}).get("stops", {}).get(stop)
+    if d:
+        return d
+    cells = summary.get("cell_names", [])
+    claims = [c for c in summary.get("regime_claims", []) if c["stop"] == stop]
+    return {"groups": {c: [c] for c in cells}, "envelopes": summary["envelopes"],
+            "regime_claims": claims, "level": None}  # fmt: skip
+
+
 def cells_by_winner(summary: dict, stop: str, idea: str = "vertex") -> dict[str, list[str]]:
-    """``{"path": cells, idea: cells, "unclear": cells}``: the regime cells (in the study's
-    order) where the path envelope needs clearly fewer iterations than the ``idea`` envelope
-    (their paired ratio's CI below 1), where ``idea``'s needs clearly fewer (CI above 1), and
-    the others."""
+    """``{"path": cells, idea: cells, "unclear": cells}``: the distinct regime cells (in the
+    study's order; :mod:`.distinct`) where the path envelope needs clearly fewer iterations
+    than the ``idea`` envelope (their paired ratio's CI, corrected over the distinct cells,
+    below 1), where ``idea``'s needs clearly fewer (CI above 1), and the others."""
+    d = _distinct(summary, stop)
     out: dict[str, list[str]] = {"path": [], idea: [], "unclear": []}
     rows = {
         r["regime"]: r["iterations"]
-        for r in summary["envelopes"]
+        for r in d["envelopes"]
         if r["stop"] == stop and r["idea"] == idea
     }
-    for cell in summary["cell_names"]:
+    for cell in d["groups"]:
         if cell in rows:
             out[_word(rows[cell], idea, "path", "unclear")].append(cell)
     return out
+
+
+def _corrected(summary: dict, stop: str) -> str:
+    """How the per-cell counts were made: over distinct cells, Bonferroni-corrected."""
+    d = _distinct(summary, stop)
+    if d["level"] is None:
+        return ""
+    same = [f"{' = '.join(cells)}" for cells in d["groups"].values() if len(cells) > 1]
+    merged = f"; the same runs: {'; '.join(same)}" if same else ""
+    return (f" (counted over {len(d['groups'])} distinct cells{merged}; each interval at "
+            f"{d['level']:.3%}, Bonferroni over the distinct cells)")  # fmt: skip
 
 
 def _winner_finding(summary: dict, stop: str, eps: float) -> list[str]:
@@ -105,7 +132,8 @@ def _winner_finding(summary: dict, stop: str, eps: float) -> list[str]:
         f"Path envelope against vertex envelope, per regime cell ({stop_name(stop, eps)}): "
         f"the path envelope needs clearly fewer iterations in {len(won['path'])} of {n} "
         f"cells{named(won['path'])}; the vertex envelope in {len(won['vertex'])}"
-        f"{named(won['vertex'])}; no clear difference in {len(won['unclear'])}."
+        f"{named(won['vertex'])}; no clear difference in {len(won['unclear'])}"
+        f"{_corrected(summary, stop)}."
     ]
 
 
@@ -177,11 +205,15 @@ def conclusion(summary: dict) -> list[str]:
             f"{r['idea']} envelope's iterations saved ({stop_name('optimal', eps)})."
         )
     out += quality_needed(summary, eps)
-    for c in summary["regime_claims"]:
+    claims = [c for stop in OPTIMAL_STOPS for c in _distinct(summary, stop)["regime_claims"]]
+    pairs = list(dict.fromkeys((c["planner"], c["baseline"]) for c in claims))
+    claims.sort(key=lambda c: (pairs.index((c["planner"], c["baseline"])), c["stop"]))
+    for c in claims:
         n = len(c["holds"]) + len(c["reversed"]) + len(c["unclear"])
         out.append(
             f"{c['claim']} ({stop_name(c['stop'], eps)}): holds in {len(c['holds'])} of "
-            f"{n} cells, reversed in {len(c['reversed'])}, unclear in {len(c['unclear'])}."
+            f"{n} distinct cells, reversed in {len(c['reversed'])}, unclear in "
+            f"{len(c['unclear'])}."
         )
     return out
 
@@ -224,17 +256,28 @@ def quality_needed(summary: dict, eps: float) -> list[str]:
 
 
 def selection_table(summary: dict, stop: str) -> str:
-    """Per family: members tried, the envelope chosen and its selection speed-up."""
+    """Per family: members tried, the envelope chosen, its selection speed-up and whether it
+    sits on its grid's edge (:mod:`.edges`)."""
     sel = summary["selection"]
     lines = [
-        "| family | members | envelope (chosen) | its speed-up on the selection |",
-        "| --- | --- | --- | --- |",
+        "| family | members | envelope (chosen) | its speed-up on the selection | on its grid's "
+        "edge? |",
+        "| --- | --- | --- | --- | --- |",
     ]
     for idea, cells in sel["speedups"].get(stop, {}).items():
         chosen = sel["envelopes"].get(stop, {}).get(idea)
         if chosen:
-            lines.append(f"| {idea} | {len(cells)} | {label(chosen)} | {cells[chosen]:.2f}x |")
+            e = sel.get("edges", {}).get(stop, {}).get(idea)
+            where = "—" if e is None else _edge_cell(e)
+            lines.append(
+                f"| {idea} | {len(cells)} | {label(chosen)} | {cells[chosen]:.2f}x | {where} |"
+            )
     return "\n".join(lines)
+
+
+def _edge_cell(edges: list[str]) -> str:
+    """An envelope's place on its grid: its edges, or interior (a bound)."""
+    return "; ".join(edges) + ": the best measured member" if edges else "no: interior, a bound"
 
 
 def envelope_table(summary: dict, stop: str) -> str:

@@ -11,6 +11,8 @@ its family's envelope).
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pandas as pd
 
@@ -18,6 +20,8 @@ from vnrrt.evaluation.keys import ConfigKey, label
 from vnrrt.evaluation.sources import OracleSource
 from vnrrt.evaluation.stats import compare
 from vnrrt.studies.sampling_ideas import design as d
+from vnrrt.studies.sampling_ideas.distinct import effective_keys, groups
+from vnrrt.studies.sampling_ideas.edges import envelope_edges
 from vnrrt.studies.sampling_ideas.selection import member_speedups, select
 
 BASELINE = ConfigKey("rrt_star")
@@ -248,11 +252,48 @@ def regime_claims(rows: list[dict], pairs: list[tuple[str, str]], table, boot) -
     return out
 
 
-def analyze_study(tables: dict, study: dict, pairs: list[tuple[str, str]], settings: dict) -> dict:
+def distinct_summary(ev: pd.DataFrame, study: dict, envelopes: dict, pairs: list, settings: dict,
+                     free: dict[int, int] | None) -> dict:  # fmt: skip
+    """Per optimal stop rule, the regime cells counted once per distinct setting
+    (:mod:`.distinct`, from that stop's runs of the configurations every cell ran):
+    ``groups`` (representative -> cells), and the envelope comparisons and claims of the
+    representatives at the Bonferroni level over the distinct cells (``level``), from enough
+    resamples that each tail holds ``settings["tail_draws"]`` draws (``bootstrap``)."""
+    cells = {d.PROTOCOL: study["protocol"], **d.regime_cells(study["regime"], study["protocol"])}
+    settings_of = _settings_of(cells, ev)
+    shared = set.intersection(*(set(t["key"]) for _, t in ev.groupby("regime", sort=False)))
+    tails = int(settings.get("tail_draws", 1))
+    out = {"free_cells": free is not None, "stops": {}}
+    for stop in ("optimal", "optimal_any_angle"):
+        runs = ev[ev["stop"] == stop]
+        if runs.empty:
+            continue
+        found = groups(effective_keys(runs[runs["key"].isin(shared)], settings_of, free))
+        strict = 1.0 - (1.0 - float(settings["level"])) / max(len(found), 1)
+        n_boot = max(int(settings["bootstrap"]), math.ceil(tails / ((1 - strict) / 2) - 1e-6))
+        reps = runs[runs["regime"].isin(found)]
+        rows, boot = [{"regime": c} for c in found], (n_boot, strict)
+        out["stops"][stop] = {
+            "groups": found, "level": strict, "bootstrap": n_boot,
+            "envelopes": envelope_rows(reps, envelopes, boot),
+            "regime_claims": regime_claims(rows, pairs, reps, boot),
+        }  # fmt: skip
+    return out
+
+
+def _settings_of(cells: dict, ev: pd.DataFrame) -> dict:
+    """Each evaluated cell's settings; a cell of an older design (not in ``cells``) by its
+    label (``eta=5 radius=shrinking*0.5 goal=inf``)."""
+    return {c: cells.get(c) or d.cell_of_label(c) for c in dict.fromkeys(ev["regime"])}
+
+
+def analyze_study(tables: dict, study: dict, pairs: list[tuple[str, str]], settings: dict,
+                  free: dict[int, int] | None = None) -> dict:  # fmt: skip
     """The whole summary: ``tables`` the merged selection (``oracle``) and evaluation
     (``regime``) trials; ``study`` the ``oracle``, ``regime`` and ``ev`` (eval) sections, the
     ``protocol`` cell's planner settings and the networks' ``targets``; ``settings`` (kept
-    for the readers) at least ``bootstrap`` and ``level``."""
+    for the readers) at least ``bootstrap``, ``level`` and ``tail_draws``; ``free``: each
+    instance's free cells (the distinct-cell rule, :mod:`.distinct`; None: settings only)."""
     oc, rc = study["oracle"], study["regime"]
     boot = (int(settings["bootstrap"]), float(settings["level"]))
     sel, ev = tables["oracle"], tables["regime"]
@@ -265,6 +306,7 @@ def analyze_study(tables: dict, study: dict, pairs: list[tuple[str, str]], setti
         "selection": {
             "speedups": speedups,
             "envelopes": envelopes,
+            "edges": envelope_edges(envelopes, oc),
             "instances": int(sel["instance"].nunique()),
             "maps": sorted(int(c) for c in sel["cluster"].unique()),
         },
@@ -281,6 +323,9 @@ def analyze_study(tables: dict, study: dict, pairs: list[tuple[str, str]], setti
         "maps": sorted(int(c) for c in ev["cluster"].unique()) if len(ev) else [],
         "cell_names": list(dict.fromkeys(ev["regime"])) if len(ev) else [],
         "regimes": d.regime_cells(rc, study["protocol"]) if rc else {},
+        "distinct": distinct_summary(ev, study, envelopes, pairs, settings, free)
+        if len(ev) and rc
+        else {},
     }
 
 
