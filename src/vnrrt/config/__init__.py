@@ -162,8 +162,10 @@ def sections(cfg: DictConfig | dict, **schemas: type) -> dict[str, Any]:
     return {name: section(cfg, name, schema) for name, schema in schemas.items()}
 
 
-def load_params(path: str | Path = "params.yaml") -> DictConfig:
-    """Load the composed parameters file (``params.yaml``) written by DVC or ``make params``."""
+def load_params(path: str | Path = "params.yaml", optional: tuple[str, ...] = ()) -> DictConfig:
+    """Load the composed parameters file (``params.yaml``) written by DVC or ``make params``;
+    every section of the composition must be there but those named ``optional`` (sections
+    newer than a kept file, which its reader does not read)."""
     from omegaconf import DictConfig, OmegaConf
 
     path = Path(path)
@@ -175,7 +177,7 @@ def load_params(path: str | Path = "params.yaml") -> DictConfig:
         raise ConfigError(f"parameters file {path} is not valid YAML: {err}") from None
     if not isinstance(cfg, DictConfig) or not cfg:
         raise ConfigError(f"parameters file {path} is empty or not a mapping (run `make params`)")
-    missing = [k for k in sections_of_composition() if k not in cfg]
+    missing = [k for k in sections_of_composition() if k not in cfg and k not in optional]
     if missing:
         raise ConfigError(f"parameters file {path} lacks the sections {missing}: cut short or "
                           "not a composition of conf/ (run `make params`)")  # fmt: skip

@@ -35,6 +35,7 @@ BUNDLE = {  # file -> what it holds
     "train.json": "each network's training metrics (steps, images, time, architecture; with "
     "eval.gpu also the GPU-trained networks')",
 }
+LATER_SECTIONS = ("bench_maps",)  # sections a bundle may predate: no recomputed stage reads them
 MACHINE = "machine.json"  # optional: {"machine": the CPU whose timings the tables hold}
 
 
@@ -121,7 +122,7 @@ def recompute(bundle: Path, out: Path) -> list[Path]:
     missing = [n for n in BUNDLE if not (bundle / n).is_file()]
     if missing:
         raise ConfigError(f"results bundle {bundle} lacks {missing} (see its README.md)")
-    cfg = load_params(bundle / "params.yaml")
+    cfg = load_params(bundle / "params.yaml", optional=LATER_SECTIONS)
     # every input comes from the bundle but the paper's numbers and settings, read where this
     # repository keeps them: the paths of this code, not of the run that made the bundle
     cfg.paths = compose([f"scale={cfg.scale.name}"]).paths
