@@ -101,7 +101,7 @@ def check_stop_target(stop, reference_length, start, goal, config=None) -> None:
     if reference_length is None:
         return
     kind = type(reference_length)  # float and int first: the abc check costs a microsecond
-    if kind is not float and kind is not int and (
+    if kind not in (float, int) and (
         kind is bool or not isinstance(reference_length, numbers.Real)
     ):
         raise TypeError(f"reference_length must be a number (pixels) or None, got "
