@@ -28,6 +28,7 @@ whose 4-word ``uint64`` state is seeded as :class:`numpy.random.SeedSequence` se
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -91,8 +92,15 @@ class Sampler:
 
 
 def uniform_sampler(shape: tuple[int, int]) -> Sampler:
-    """Uniform sampler over the ``(H, W)`` map."""
-    return Sampler("uniform", 0.0, np.zeros(0), -1, (int(shape[0]), int(shape[1])))
+    """Uniform sampler over the ``(H, W)`` map (one per shape: it holds nothing else)."""
+    return _uniform((int(shape[0]), int(shape[1])))
+
+
+@functools.lru_cache(maxsize=64)
+def _uniform(shape: tuple[int, int]) -> Sampler:
+    no_weights = np.zeros(0)
+    no_weights.flags.writeable = False
+    return Sampler("uniform", 0.0, no_weights, -1, shape)
 
 
 def heatmap_sampler(
