@@ -1,29 +1,19 @@
 """Samplers for the RRT* core: uniform, heatmap (NRRT*/VNRRT*) and masked (M-VNRRT*).
 
 Every sampler is the same small piece of data, a :class:`Sampler`, read by one compiled
-function, :func:`sample_point`: with probability ``mix`` a point is drawn from the
-heatmap (a pixel with probability proportional to its weight, then a uniform point
-inside that pixel), otherwise uniformly from the whole map ``[0, W) x [0, H)``
-(obstacles included, as in Algorithm 1). The uniform sampler is ``mix = 0``.
-
-* ``uniform`` (RRT*): ``mix = 0``.
-* ``heatmap`` (NRRT* with a path heatmap, VNRRT* with a vertex heatmap; Algorithm 2):
-  weights = the heatmap, ``mix = 0.5`` by default.
-* ``masked`` (M-VNRRT*): weights = the heatmap with values below ``tau`` set to zero.
-
-Informed sampling (:func:`informed_point`, used by the core once a solution exists when
-``informed`` is set) draws the same way but inside the ellipse of the points through which a
-shorter path can run.
-
-The **gap sampler** (:func:`gap_point`, any planner, ``PlannerConfig.gap_share``) draws a
-share of the samples from the map's narrow-passage cells (:mod:`.gaps`) instead;
-:func:`any_point` is the one draw the core makes.
+draw, :func:`any_point`: with probability ``mix`` a point is drawn from the heatmap (a pixel
+with probability proportional to its weight, then a uniform point inside that pixel),
+otherwise uniformly from the whole map ``[0, W) x [0, H)`` (obstacles included, as in
+Algorithm 1). ``uniform`` (RRT*) is ``mix = 0``; ``heatmap`` (NRRT* with a path heatmap,
+VNRRT* with a vertex heatmap; Algorithm 2) weighs pixels by the heatmap; ``masked``
+(M-VNRRT*) by the heatmap with values below ``tau`` set to zero. The same draw serves
+informed sampling (inside the ellipse of the points through which a shorter path can run)
+and the gap sampler (a share of the samples from the narrow-passage cells of :mod:`.gaps`).
 
 If no positive weight is left, the sampler falls back to uniform (no heatmap draws) and sets
 ``fallback_uniform``. Huge or tiny weights are scaled by a power of two before they are summed
 (the draws stay those of the given weights). Randomness comes from a xoshiro256** generator
-whose 4-word ``uint64`` state is seeded as :class:`numpy.random.SeedSequence` seeds it
-(:func:`vnrrt.planners.seeding.rng_state`); no global state.
+seeded as :class:`numpy.random.SeedSequence` seeds it (:func:`.seeding.rng_state`).
 """
 
 from __future__ import annotations
@@ -167,14 +157,6 @@ def _heat_point(s, w, cdf, last):
     return _below(px + next_double(s), px + 1.0), _below(py + next_double(s), py + 1.0)
 
 
-@njit(cache=True, inline="always")
-def sample_point(s, h, w, mix, cdf, last):
-    """One sample ``(x, y)`` in pixels (see module doc); ``s`` is the rng state."""
-    if mix > 0.0 and next_double(s) < mix:
-        return _heat_point(s, w, cdf, last)
-    return _below(next_double(s) * w, float(w)), _below(next_double(s) * h, float(h))
-
-
 INFORMED_TRIES = 64  # uniform draws until one lies in both the ellipse and the map
 HEATMAP_TRIES = 16  # heatmap draws until one lies in the ellipse
 
@@ -224,20 +206,6 @@ def ellipse_uniform(s, h, w, sx, sy, gx, gy, c_best):
 
 
 @njit(cache=True, inline="always")
-def informed_point(s, h, w, mix, cdf, last, sx, sy, gx, gy, c_best):
-    """One informed sample: with probability ``mix`` a heatmap draw conditioned on the ellipse
-    (rejection, at most :data:`HEATMAP_TRIES` draws; when all fall outside, the heatmap has
-    next to no mass in the ellipse and the sample is uniform there instead), otherwise a
-    uniform point of the ellipse inside the map (:func:`ellipse_uniform`)."""
-    if mix > 0.0 and next_double(s) < mix:
-        for _ in range(HEATMAP_TRIES):
-            x, y = _heat_point(s, w, cdf, last)
-            if in_ellipse(x, y, sx, sy, gx, gy, c_best):
-                return x, y
-    return ellipse_uniform(s, h, w, sx, sy, gx, gy, c_best)
-
-
-@njit(cache=True, inline="always")
 def _cell_point(s, w, cells, n):
     """A uniform point of a cell drawn uniformly from the first ``n`` flat indices of
     ``cells``."""
@@ -247,31 +215,25 @@ def _cell_point(s, w, cells, n):
 
 
 @njit(cache=True, inline="always")
-def gap_point(s, h, w, cells, n, informed, sx, sy, gx, gy, c_best):
-    """One draw of the gap sampler: a uniform point of a cell drawn uniformly from the ``n``
-    gap cells (flat indices ``cells``, :mod:`.gaps`); when ``informed``, conditioned on the
-    ellipse as :func:`informed_point` conditions a heatmap draw (at most
-    :data:`HEATMAP_TRIES` draws, then a uniform point of the ellipse)."""
-    if not informed:
-        return _cell_point(s, w, cells, n)
-    for _ in range(HEATMAP_TRIES):
-        x, y = _cell_point(s, w, cells, n)
-        if in_ellipse(x, y, sx, sy, gx, gy, c_best):
+def any_point(s, h, w, mix, cdf, last, share, cells, n, informed, sx, sy, gx, gy, c_best):
+    """One sample ``(x, y)`` (pixels) of a planner, ``s`` the rng state: with probability
+    ``share`` (when the ``n`` gap cells ``cells`` exist) a gap sampler's draw, else with
+    probability ``mix`` a heatmap draw, else a uniform point of the map. When ``informed``,
+    a gap or heatmap draw is conditioned on the ellipse of ``c_best`` (rejection: at most
+    :data:`HEATMAP_TRIES` draws; when all fall outside, there is next to no mass in the
+    ellipse and the sample is uniform there instead) and a uniform point is one of the
+    ellipse inside the map (:func:`ellipse_uniform`). A share or mix of 0 spends no random
+    number on its choice."""
+    gap = share > 0.0 and n > 0 and next_double(s) < share
+    if not gap and not (mix > 0.0 and next_double(s) < mix):
+        if informed:
+            return ellipse_uniform(s, h, w, sx, sy, gx, gy, c_best)
+        return _below(next_double(s) * w, float(w)), _below(next_double(s) * h, float(h))
+    for _ in range(HEATMAP_TRIES if informed else 1):
+        x, y = _cell_point(s, w, cells, n) if gap else _heat_point(s, w, cdf, last)
+        if not informed or in_ellipse(x, y, sx, sy, gx, gy, c_best):
             return x, y
     return ellipse_uniform(s, h, w, sx, sy, gx, gy, c_best)
-
-
-@njit(cache=True, inline="always")
-def any_point(s, h, w, mix, cdf, last, share, cells, n, informed, sx, sy, gx, gy, c_best):
-    """One sample of a planner: with probability ``share`` (when ``n`` gap cells exist) a
-    :func:`gap_point`, else the sampler's draw (:func:`informed_point` when ``informed``,
-    else :func:`sample_point`). With ``share`` 0 no random number is spent on the choice,
-    so the draws are those of the sampler alone."""
-    if share > 0.0 and n > 0 and next_double(s) < share:
-        return gap_point(s, h, w, cells, n, informed, sx, sy, gx, gy, c_best)
-    if informed:
-        return informed_point(s, h, w, mix, cdf, last, sx, sy, gx, gy, c_best)
-    return sample_point(s, h, w, mix, cdf, last)
 
 
 @njit(cache=True)
