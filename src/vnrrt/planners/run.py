@@ -1,21 +1,19 @@
-"""One timed planner run on a validated query: the run's settings, its tree's arrays, the
-compiled loop that grows the tree (:func:`grow_tree`) and the :class:`PlanResult` built from it.
+"""One timed planner run on a checked query: the run's settings and tree arrays, the compiled
+loop that grows the tree (:func:`grow_tree`) and the :class:`PlanResult` built from it.
 
 Coordinates follow :mod:`vnrrt.grid`: ``occ`` is the ``(H, W)`` uint8 grid indexed
 ``occ[y, x]`` (nonzero = obstacle), points are continuous ``(x, y)`` pixels, lengths pixels,
 times seconds on ``time.perf_counter``'s clock.
 
-The clock starts before the straight start-goal segment is tested (when ``straight_first``)
-and stops when the stop rule or a budget is met and a grown tree's path and trace are taken
-out of it (as OMPL's ``solve()`` builds its solution path). A free straight segment that
-meets the stop rule is the exact optimum: the run ends there, its result a two-node tree.
-Otherwise the tree grows in one compiled call (:func:`grow_tree`): chunks of
-:func:`vnrrt.planners.rrt_star.grow` (first :data:`FIRST_CHUNK` iterations, doubling up to
-:data:`MAX_CHUNK`), the budgets checked and the stop bounds' first-pass times taken between
-chunks; it returns to Python only when the run is over or the tree's arrays are full (then
-enlarged, and the call made again). The tree's arrays are allocated (or emptied for reuse by
-the next run of the same planner) before the clock starts, as OMPL's ``setup()`` is outside
-its ``solve()`` times; growing them is inside.
+The clock starts before the straight start-goal segment is tested (when ``straight_first``;
+a free segment that meets the stop rule is the exact optimum and ends the run, a two-node
+tree) and stops when the stop rule or a budget is met and the path and trace are taken out
+of the tree (as OMPL's ``solve()`` builds its solution path). The tree grows in one compiled
+call: chunks of :func:`vnrrt.planners.rrt_star.grow` (:data:`FIRST_CHUNK` iterations first,
+doubling up to :data:`MAX_CHUNK`), the budgets checked and the bounds' first-pass times
+taken between chunks; it returns to Python when the run is over or the tree's arrays are
+full (then enlarged, inside the clock). The arrays are allocated or emptied before the
+clock starts, as OMPL's ``setup()`` is outside its ``solve()`` times.
 """
 
 from __future__ import annotations
@@ -39,7 +37,7 @@ from vnrrt.planners.seeding import rng_state
 
 FIRST_CAPACITY = 4096  # tree nodes allocated first; doubled when full (up to the budget)
 FIRST_CHUNK, MAX_CHUNK = 64, 4096  # iterations per chunk; budgets checked between
-SOLVED, MAX_ITERATIONS, MAX_SECONDS = 3, 4, 5  # return codes of :func:`drive` (or TREE_FULL)
+SOLVED, MAX_ITERATIONS, MAX_SECONDS = 3, 4, 5  # return codes of :func:`grow_tree` (or TREE_FULL)
 REASONS = {SOLVED: "solved", MAX_ITERATIONS: "max_iterations", MAX_SECONDS: "max_seconds"}
 
 
