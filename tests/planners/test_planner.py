@@ -456,7 +456,7 @@ def test_a_runs_core_settings_are_its_configs_and_its_querys(cfg, planner):
     assert got == pytest.approx(want, rel=1e-15) and got.keys() == want.keys()
     d = rrt_star.Draws(*setup.draws)
     s = p.sampler
-    assert (d.mix, d.last) == (s.draw_mix, max(s.last, 0))
+    assert (d.mix, d.last) == (0.0 if s.fallback_uniform else s.mix, max(s.last, 0))
     np.testing.assert_array_equal(d.cdf, s.cdf if s.cdf.size else np.zeros(1))
     assert (d.gap_share, d.gap_width, d.gap_after) == (cfg.gap_share, cfg.gap_width, cfg.gap_after)
     assert d.n_gaps == (-1 if cfg.gap_share > 0 else 0)

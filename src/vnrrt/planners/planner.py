@@ -3,15 +3,12 @@
 
 Coordinates follow :mod:`vnrrt.grid`: ``grid`` is ``(H, W)`` indexed ``grid[y, x]``
 (nonzero = obstacle), start and goal are continuous ``(x, y)`` pixel points (cell centres
-``(x + 0.5, y + 0.5)`` for dataset instances); lengths in pixels, times in seconds. Every
-setting comes from one :class:`PlannerConfig` (the M-VNRRT* threshold ``tau`` included).
+``(x + 0.5, y + 0.5)`` for dataset instances); lengths in pixels, times in seconds.
 
-A call's path: :func:`plan` builds a :class:`Planner` and solves; :meth:`Planner.solve`
-checks the query (:mod:`.arguments`) and makes one timed run (:func:`.run.run`). Timings
-cover that run; building the sampler from a heatmap (per map, once; reported as
+:meth:`Planner.solve` checks the query (:mod:`.arguments`) and makes one timed run
+(:func:`.run.run`). Outside its times: building the sampler from a heatmap (per map, once;
 ``setup_time``), allocating the tree's arrays (per planner, reused), seeding, JIT
-compilation (once per process, :func:`warmup`) and the reference-length computation (an
-oracle, not part of planning) are outside them.
+compilation (once per process, :func:`warmup`) and the reference length (an oracle).
 """
 
 from __future__ import annotations

@@ -35,7 +35,7 @@ from vnrrt.planners import spatial
 from vnrrt.planners.collision import segment_free
 from vnrrt.planners.gaps import gap_cells
 from vnrrt.planners.refine import AT_REST, IMPROVED, refine_step
-from vnrrt.planners.samplers import NO_CELLS, any_point, next_double
+from vnrrt.planners.samplers import Draws, any_point, next_double
 from vnrrt.planners.tree import PARENT, add_node, best_cost, record, reparent
 
 RUNNING, MILESTONE_HIT, TREE_FULL = 0, 1, 2  # return codes of :func:`grow`
@@ -62,23 +62,6 @@ class Params(NamedTuple):
     refine: float = 0.0
     pull_parents: bool = False
     refine_branches: float = 0.0
-
-
-class Draws(NamedTuple):
-    """The sampler: heatmap draw probability ``mix``, cumulative weights ``cdf`` over flat
-    pixels and the last pixel with weight (see :mod:`.samplers`); the gap sampler: its share
-    ``gap_share`` of the samples, the widest passage ``gap_width`` (cells), the iterations
-    ``gap_after`` before its first draw, and the first ``n_gaps`` flat indices of
-    ``gap_cells`` it draws from (:mod:`.gaps`; ``n_gaps`` -1: not found yet, 0: none)."""
-
-    mix: float
-    cdf: np.ndarray
-    last: int
-    gap_share: float = 0.0
-    gap_width: int = 8
-    gap_after: int = 0
-    gap_cells: np.ndarray = NO_CELLS
-    n_gaps: int = 0
 
 
 @njit(cache=True)
@@ -218,9 +201,8 @@ def near_radius(n, p):
 def sample(rng, h, w, draws, p, c_best):
     """Sample: the sampler's (or the gap sampler's) draw, inside the informed ellipse once
     a solution exists (:func:`vnrrt.planners.samplers.any_point`)."""
-    d = draws
-    return any_point(rng, h, w, d.mix, d.cdf, d.last, d.gap_share, d.gap_cells, d.n_gaps,
-                     p.informed and c_best < np.inf, p.sx, p.sy, p.gx, p.gy, c_best)  # fmt: skip
+    ellipse = (p.informed and c_best < np.inf, p.sx, p.sy, p.gx, p.gy, c_best)
+    return any_point(rng, h, w, draws, ellipse)
 
 
 @njit(cache=True)

@@ -31,8 +31,8 @@ from vnrrt.planners import tree as nodes
 from vnrrt.planners.clock import monotonic
 from vnrrt.planners.config import PlannerConfig
 from vnrrt.planners.result import Milestone, PlanResult
-from vnrrt.planners.rrt_star import TREE_FULL, Draws, Params
-from vnrrt.planners.samplers import NO_CELLS, Sampler
+from vnrrt.planners.rrt_star import TREE_FULL, Params
+from vnrrt.planners.samplers import Draws, Sampler
 from vnrrt.planners.seeding import rng_state
 
 FIRST_CAPACITY = 4096  # tree nodes allocated first; doubled when full (up to the budget)
@@ -127,13 +127,10 @@ class Setup:
 
     @functools.cached_property
     def draws(self) -> tuple:
-        """The sampler and the gap sampler as the core reads them (a plain :class:`Draws`)."""
-        cfg, sampler = self.cfg, self.sampler
-        cdf = sampler.cdf if sampler.cdf.size else np.zeros(1)
-        share = float(cfg.gap_share)  # the gap cells pending (-1) when used: found in the run
-        return tuple(Draws(float(sampler.draw_mix), cdf, max(sampler.last, 0), share,
-                           int(cfg.gap_width), int(cfg.gap_after), NO_CELLS,
-                           -1 if share > 0 else 0))  # fmt: skip
+        """The sampler and the gap sampler as the core reads them (a plain :class:`Draws`;
+        the gap cells, when used, found in the run)."""
+        cfg = self.cfg
+        return tuple(self.sampler.draws(cfg.gap_share, cfg.gap_width, cfg.gap_after))
 
     def fresh(self) -> Tree:
         """An empty tree: allocated (:data:`FIRST_CAPACITY` nodes, or the budget's) by the

@@ -21,6 +21,7 @@ from __future__ import annotations
 import functools
 import math
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
@@ -30,6 +31,23 @@ from vnrrt.planners.seeding import rng_state
 
 _INV_2_53 = 1.0 / 9007199254740992.0
 NO_CELLS = np.zeros(1, np.int64)  # the gap cells of a sampler without (or not yet with) any
+
+
+class Draws(NamedTuple):
+    """A sampler as the compiled draw reads it: heatmap draw probability ``mix``, cumulative
+    weights ``cdf`` over flat pixels and the last pixel with weight; the gap sampler: its
+    share ``gap_share`` of the samples, the widest passage ``gap_width`` (cells), the
+    iterations ``gap_after`` before its first draw, and the first ``n_gaps`` flat indices of
+    ``gap_cells`` it draws from (:mod:`.gaps`; ``n_gaps`` -1: not found yet, 0: none)."""
+
+    mix: float
+    cdf: np.ndarray
+    last: int
+    gap_share: float = 0.0
+    gap_width: int = 8
+    gap_after: int = 0
+    gap_cells: np.ndarray = NO_CELLS
+    n_gaps: int = 0
 
 
 @njit(cache=True, inline="always")
@@ -75,10 +93,16 @@ class Sampler:
     fallback_uniform: bool = False
     tau: float | None = None
 
-    @property
-    def draw_mix(self) -> float:
-        """Probability that a sample is a heatmap draw: ``mix``, or 0 without weights."""
-        return 0.0 if self.fallback_uniform or self.last < 0 else self.mix
+    def draws(self, gap_share=0.0, gap_width=8, gap_after=0, cells=None) -> Draws:
+        """This sampler as the compiled draw reads it, with the gap sampler's settings and
+        flat ``cells`` (None: pending, found by the run when ``gap_share > 0``). Without
+        weights (uniform, or after a fallback) no heatmap draw is made (``mix`` 0)."""
+        mix = 0.0 if self.fallback_uniform or self.last < 0 else float(self.mix)
+        cdf = self.cdf if self.cdf.size else np.zeros(1)
+        n = (-1 if gap_share > 0 else 0) if cells is None else cells.size
+        cells = NO_CELLS if cells is None or cells.size == 0 else cells
+        return Draws(mix, cdf, max(self.last, 0), float(gap_share), int(gap_width),
+                     int(gap_after), cells, n)  # fmt: skip
 
 
 def uniform_sampler(shape: tuple[int, int]) -> Sampler:
@@ -215,33 +239,36 @@ def _cell_point(s, w, cells, n):
 
 
 @njit(cache=True, inline="always")
-def any_point(s, h, w, mix, cdf, last, share, cells, n, informed, sx, sy, gx, gy, c_best):
-    """One sample ``(x, y)`` (pixels) of a planner, ``s`` the rng state: with probability
-    ``share`` (when the ``n`` gap cells ``cells`` exist) a gap sampler's draw, else with
-    probability ``mix`` a heatmap draw, else a uniform point of the map. When ``informed``,
-    a gap or heatmap draw is conditioned on the ellipse of ``c_best`` (rejection: at most
-    :data:`HEATMAP_TRIES` draws; when all fall outside, there is next to no mass in the
-    ellipse and the sample is uniform there instead) and a uniform point is one of the
-    ellipse inside the map (:func:`ellipse_uniform`). A share or mix of 0 spends no random
-    number on its choice."""
-    gap = share > 0.0 and n > 0 and next_double(s) < share
-    if not gap and not (mix > 0.0 and next_double(s) < mix):
+def any_point(s, h, w, d, ellipse):
+    """One sample ``(x, y)`` (pixels) of the sampler ``d`` (a :class:`Draws`), ``s`` the rng
+    state: with probability ``d.gap_share`` (when gap cells exist) a gap sampler's draw, else
+    with probability ``d.mix`` a heatmap draw, else a uniform point of the map. ``ellipse``
+    is ``(informed, sx, sy, gx, gy, c_best)``: when informed, a gap or heatmap draw is
+    conditioned on the ellipse of ``c_best`` (rejection: at most :data:`HEATMAP_TRIES`
+    draws; when all fall outside, there is next to no mass in the ellipse and the sample is
+    uniform there instead) and a uniform point is one of the ellipse inside the map
+    (:func:`ellipse_uniform`). A share or mix of 0 spends no random number on its choice."""
+    informed, sx, sy, gx, gy, c_best = ellipse
+    gap = d.gap_share > 0.0 and d.n_gaps > 0 and next_double(s) < d.gap_share
+    if not gap and not (d.mix > 0.0 and next_double(s) < d.mix):
         if informed:
             return ellipse_uniform(s, h, w, sx, sy, gx, gy, c_best)
         return _below(next_double(s) * w, float(w)), _below(next_double(s) * h, float(h))
     for _ in range(HEATMAP_TRIES if informed else 1):
-        x, y = _cell_point(s, w, cells, n) if gap else _heat_point(s, w, cdf, last)
+        if gap:
+            x, y = _cell_point(s, w, d.gap_cells, d.n_gaps)
+        else:
+            x, y = _heat_point(s, w, d.cdf, d.last)
         if not informed or in_ellipse(x, y, sx, sy, gx, gy, c_best):
             return x, y
     return ellipse_uniform(s, h, w, sx, sy, gx, gy, c_best)
 
 
 @njit(cache=True)
-def _draw(s, count, h, w, mix, cdf, last, share, cells, n, informed, sx, sy, gx, gy, c_best):
+def _draw(s, count, h, w, d, ellipse):
     out = np.empty((count, 2))
     for k in range(count):
-        p = any_point(s, h, w, mix, cdf, last, share, cells, n, informed, sx, sy, gx, gy, c_best)
-        out[k, 0], out[k, 1] = p
+        out[k, 0], out[k, 1] = any_point(s, h, w, d, ellipse)
     return out
 
 
@@ -251,26 +278,8 @@ def draw(sampler: Sampler, n: int, seed=0, ellipse=None, gaps=None) -> np.ndarra
     costs ``c_best``; ``gaps=(share, cells)`` mixes in the gap sampler's draws as a planner
     with ``gap_share=share`` does (``cells``: flat indices, :func:`vnrrt.planners.gaps.
     gap_cells`)."""
-    h, w = sampler.shape
-    cdf = sampler.cdf if sampler.cdf.size else np.zeros(1)
     (sx, sy), (gx, gy), c_best = ellipse if ellipse is not None else ((0, 0), (0, 0), 0.0)
-    share, cells = gaps if gaps is not None else (0.0, NO_CELLS)
-    cells = np.asarray(cells, np.int64)
-    return _draw(
-        rng_state(seed),
-        int(n),
-        h,
-        w,
-        sampler.draw_mix,
-        cdf,
-        max(sampler.last, 0),
-        float(share),
-        cells if cells.size else NO_CELLS,
-        int(cells.size),
-        ellipse is not None,
-        float(sx),
-        float(sy),
-        float(gx),
-        float(gy),
-        float(c_best),
-    )
+    share, cells = (gaps[0], np.asarray(gaps[1], np.int64)) if gaps is not None else (0.0, None)
+    d = sampler.draws(share, cells=cells)
+    ends = (ellipse is not None, float(sx), float(sy), float(gx), float(gy), float(c_best))
+    return _draw(rng_state(seed), int(n), *sampler.shape, d, ends)
