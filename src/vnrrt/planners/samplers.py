@@ -173,10 +173,14 @@ def _below(v, hi):
 
 
 @njit(cache=True, inline="always")
-def _heat_point(s, w, cdf, last):
-    """A pixel drawn with probability proportional to its weight, then a uniform point in it."""
-    u = next_double(s) * cdf[last]
-    i = min(np.searchsorted(cdf, u, side="right"), last)
+def _pixel_point(s, w, d, gap):
+    """A uniform point of a pixel of a ``W`` wide map drawn from the sampler ``d``: one of the
+    first ``d.n_gaps`` gap cells, uniformly, when ``gap``, else a pixel with probability
+    proportional to its weight."""
+    if gap:
+        i = d.gap_cells[min(int(next_double(s) * d.n_gaps), d.n_gaps - 1)]
+    else:
+        i = min(np.searchsorted(d.cdf, next_double(s) * d.cdf[d.last], side="right"), d.last)
     px, py = float(i % w), float(i // w)
     return _below(px + next_double(s), px + 1.0), _below(py + next_double(s), py + 1.0)
 
@@ -230,15 +234,6 @@ def ellipse_uniform(s, h, w, sx, sy, gx, gy, c_best):
 
 
 @njit(cache=True, inline="always")
-def _cell_point(s, w, cells, n):
-    """A uniform point of a cell drawn uniformly from the first ``n`` flat indices of
-    ``cells``."""
-    i = cells[min(int(next_double(s) * n), n - 1)]
-    px, py = float(i % w), float(i // w)
-    return _below(px + next_double(s), px + 1.0), _below(py + next_double(s), py + 1.0)
-
-
-@njit(cache=True, inline="always")
 def any_point(s, h, w, d, ellipse):
     """One sample ``(x, y)`` (pixels) of the sampler ``d`` (a :class:`Draws`), ``s`` the rng
     state: with probability ``d.gap_share`` (when gap cells exist) a gap sampler's draw, else
@@ -255,10 +250,7 @@ def any_point(s, h, w, d, ellipse):
             return ellipse_uniform(s, h, w, sx, sy, gx, gy, c_best)
         return _below(next_double(s) * w, float(w)), _below(next_double(s) * h, float(h))
     for _ in range(HEATMAP_TRIES if informed else 1):
-        if gap:
-            x, y = _cell_point(s, w, d.gap_cells, d.n_gaps)
-        else:
-            x, y = _heat_point(s, w, d.cdf, d.last)
+        x, y = _pixel_point(s, w, d, gap)
         if not informed or in_ellipse(x, y, sx, sy, gx, gy, c_best):
             return x, y
     return ellipse_uniform(s, h, w, sx, sy, gx, gy, c_best)
