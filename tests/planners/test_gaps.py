@@ -1,4 +1,4 @@
-"""The gap sampler (planners/gaps.py, samplers.gap_point, PlannerConfig.gap_share): its cells
+"""The gap sampler (planners/gaps.py, samplers.any_point, PlannerConfig.gap_share): its cells
 against a brute-force reference, its draws, and its runs through the planner's results."""
 
 import math

@@ -11,16 +11,10 @@ makes one timed run (:mod:`.run`), whose tree grows in one compiled call of the 
 from vnrrt.planners.collision import path_free, point_free, polyline_length, segment_free
 from vnrrt.planners.config import FASTEST, PLANNERS, PlannerConfig, PlannerConfigError
 from vnrrt.planners.planner import Planner, make_sampler, plan, warmup
-from vnrrt.planners.reference import (
-    any_angle_length,
-    any_angle_path,
-    astar_length,
-    reference_length,
-    taut_length,
-    taut_path,
-)
+from vnrrt.planners.reference import astar_length, reference_length, taut_length, taut_path
 from vnrrt.planners.result import Milestone, PlanResult
 from vnrrt.planners.samplers import Sampler, draw, heatmap_sampler, uniform_sampler
+from vnrrt.search import any_angle_length, any_angle_path
 
 __all__ = [
     "FASTEST",

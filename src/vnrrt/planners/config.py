@@ -2,13 +2,9 @@
 (read here, written nowhere else), and :data:`FASTEST`, ``conf/planner/fastest.yaml`` (the
 Hydra option ``planner=fastest``). Lengths in pixels, times in seconds.
 
-The files are read by :func:`vnrrt.config.conf_defaults` and :func:`vnrrt.config.conf_file`
-from ``conf/planner`` of :data:`vnrrt.config.CONF_DIR` (the repository's ``conf/``, in an
-installed wheel its packaged copy), as every typed section's defaults are. Kept free of
-Hydra/OmegaConf (the files are read with PyYAML) so that :mod:`vnrrt.planners` depends only
-on :mod:`vnrrt.grid`, :mod:`vnrrt.search` and the readers of :mod:`vnrrt.config`;
-``vnrrt.config.section(cfg, "planner", PlannerConfig)`` validates the composed YAML against
-this dataclass.
+The files are read with PyYAML by the readers of :mod:`vnrrt.config` (no Hydra here), from
+the repository's ``conf/`` or, in an installed wheel, its packaged copy;
+``vnrrt.config.section(cfg, "planner", PlannerConfig)`` validates a composed configuration.
 """
 
 from __future__ import annotations

@@ -3,58 +3,29 @@
 
 Coordinates follow :mod:`vnrrt.grid`: ``grid`` is ``(H, W)`` indexed ``grid[y, x]``
 (nonzero = obstacle), start and goal are continuous ``(x, y)`` pixel points (cell centres
-``(x + 0.5, y + 0.5)`` for dataset instances); lengths in pixels, times in seconds. Every
-setting comes from one :class:`PlannerConfig` (the M-VNRRT* threshold ``tau`` included).
+``(x + 0.5, y + 0.5)`` for dataset instances); lengths in pixels, times in seconds.
 
-:meth:`Planner.solve` checks the query, then makes one timed run (:func:`.run.run`: the
-straight segment when ``straight_first``, else the compiled RRT* core). Timings cover that
-run; building the sampler from a heatmap (per map, once; reported as ``setup_time``),
-allocating the tree's arrays (per planner, reused), seeding, JIT compilation (once per
-process, :func:`warmup`) and the reference-length computation (an oracle, not part of
-planning) are outside them.
+:meth:`Planner.solve` checks the query (:mod:`.arguments`) and makes one timed run
+(:func:`.run.run`). Outside its times: building the sampler from a heatmap (per map, once;
+``setup_time``), allocating the tree's arrays (per planner, reused), seeding, JIT
+compilation (once per process, :func:`warmup`) and the reference length (an oracle).
 """
 
 from __future__ import annotations
 
 import functools
 import logging
-import math
-import numbers
 import time
 
 import numpy as np
 
-from vnrrt.grid import GridError, as_occupancy, as_point
-from vnrrt.planners import run
-from vnrrt.planners.arguments import check_stop_target
-from vnrrt.planners.collision import segment_free
-from vnrrt.planners.config import PLANNERS, PlannerConfig
+from vnrrt.planners import arguments, run
+from vnrrt.planners.config import PlannerConfig
 from vnrrt.planners.reference import reference_length as compute_reference
 from vnrrt.planners.result import PlanResult
 from vnrrt.planners.samplers import Sampler, heatmap_sampler, uniform_sampler
 
 log = logging.getLogger(__name__)
-
-SAMPLER_KINDS = {
-    "rrt_star": "uniform",
-    "nrrt_star": "heatmap",
-    "vnrrt_star": "heatmap",
-    "m_vnrrt_star": "masked",
-}
-
-
-def _known(planner: str) -> None:
-    if planner not in PLANNERS:
-        raise ValueError(f"unknown planner {planner!r}; choose from {PLANNERS}")
-
-
-def _config(config: PlannerConfig | None) -> PlannerConfig:
-    if config is None:
-        return PlannerConfig()
-    if not isinstance(config, PlannerConfig):
-        raise TypeError(f"config must be a PlannerConfig, got {type(config).__name__}")
-    config.validate()  # remembered: a frozen config is checked once
-    return config
 
 
 def make_sampler(
@@ -62,8 +33,8 @@ def make_sampler(
 ) -> Sampler:
     """The sampler of ``planner`` for an ``(H, W)`` map (see :mod:`.samplers`), built with
     ``config.mix`` and, for M-VNRRT*, ``config.tau``."""
-    _known(planner)
-    cfg = _config(config)
+    arguments.check_planner(planner)
+    cfg = arguments.checked_config(config)
     if planner == "rrt_star":
         if heatmap is not None:
             raise ValueError("rrt_star samples uniformly and takes no heatmap")
@@ -72,53 +43,6 @@ def make_sampler(
         raise ValueError(f"{planner} needs a heatmap of shape {tuple(shape)}")
     tau = cfg.tau if planner == "m_vnrrt_star" else None
     return heatmap_sampler(heatmap, shape, cfg.mix, tau)
-
-
-def check_sampler(
-    sampler: Sampler, planner: str, shape: tuple[int, int], config: PlannerConfig
-) -> None:
-    """Raise ``ValueError`` unless ``sampler`` is what ``planner`` samples from on a map of
-    ``shape`` with ``config`` (its kind, shape, ``mix`` and, when masked, ``tau``)."""
-    want = SAMPLER_KINDS[planner]
-    if sampler.kind != want:
-        raise ValueError(f"{planner} samples from a {want} sampler, got a {sampler.kind} one")
-    if tuple(sampler.shape) != tuple(shape):
-        raise GridError(f"sampler is for shape {sampler.shape}, the grid has shape {shape}")
-    if want != "uniform" and sampler.mix != config.mix:
-        raise ValueError(f"sampler was built with mix={sampler.mix}, the config has {config.mix}")
-    if want == "masked" and sampler.tau != config.tau:
-        raise ValueError(f"sampler was built with tau={sampler.tau}, the config has {config.tau}")
-
-
-def _occupancy(grid) -> np.ndarray:
-    """``grid`` as the core reads it: a C-contiguous 2-D uint8 ``np.ndarray`` (at least 2x2;
-    not a subclass) is used as it is (nonzero = obstacle, no copy); anything else goes through
-    :func:`as_occupancy`."""
-    if type(grid) is np.ndarray and grid.dtype == np.uint8 and grid.ndim == 2:  # noqa: SIM102
-        if min(grid.shape) >= 2 and grid.flags.c_contiguous:  # (shape read on 2-D arrays only)
-            return grid
-    return as_occupancy(grid)
-
-
-def _endpoint(occ: np.ndarray, point, name: str) -> tuple[float, float]:
-    """``point`` as floats ``(x, y)``: finite, in a free cell, touching no obstacle or border
-    (one compiled test; a point that fails it is named by :func:`as_point` or here)."""
-    try:
-        x, y = point
-        x, y = float(x), float(y)
-    except (TypeError, ValueError):
-        x = y = math.nan
-    if math.isfinite(x) and math.isfinite(y) and segment_free(occ, x, y, x, y):
-        return x, y
-    x, y = as_point(occ, point, name)  # names a malformed point, one outside, one in an obstacle
-    raise GridError(f"{name} {(x, y)} touches an obstacle cell or the map border")
-
-
-def _check_seed(seed) -> None:
-    """Raise ``ValueError`` unless ``seed`` is an int >= 0 or a tuple (or list) of them."""
-    parts = seed if isinstance(seed, tuple | list) else (seed,)
-    if not all(isinstance(s, numbers.Integral) and s >= 0 for s in parts):
-        raise ValueError(f"seed must be an int >= 0 or a tuple of them, got {seed!r}")
 
 
 class Planner:
@@ -151,9 +75,9 @@ class Planner:
         config: PlannerConfig | None = None,
         sampler: Sampler | None = None,
     ):
-        _known(planner)
-        self.planner, self.config = planner, _config(config)
-        self.occ = _occupancy(grid)
+        arguments.check_planner(planner)
+        self.planner, self.config = planner, arguments.checked_config(config)
+        self.occ = arguments.occupancy(grid)
         self.setup_time = 0.0
         if sampler is None:
             t0 = time.perf_counter()
@@ -162,7 +86,7 @@ class Planner:
         elif heatmap is not None:
             raise ValueError("give either a prebuilt sampler or a heatmap, not both")
         else:
-            check_sampler(sampler, planner, self.occ.shape, self.config)
+            arguments.check_sampler(sampler, planner, self.occ.shape, self.config)
         self.sampler = sampler
         self.setup = run.Setup(self.occ, self.config, sampler)
 
@@ -211,15 +135,19 @@ class Planner:
                ) -> run.Query:  # fmt: skip
         """The checked query of :meth:`solve` (arguments and errors there), its reference
         computed when ``stop`` is ``'optimal'`` and none is given."""
-        check_stop_target(stop, reference_length, start, goal, self.config)
-        start, goal = _endpoint(self.occ, start, "start"), _endpoint(self.occ, goal, "goal")
-        if stop not in ("initial", "optimal"):
+        arguments.check_stop_target(stop, reference_length, start, goal, self.config)
+        start = arguments.endpoint(self.occ, start, "start")
+        goal = arguments.endpoint(self.occ, goal, "goal")
+        if stop != "initial" and stop != "optimal":
             raise ValueError(f"unknown stop rule {stop!r}; use 'initial' or 'optimal'")
-        _check_seed(seed)
-        if reference_length is None and stop == "optimal":
-            reference_length = compute_reference(self.occ, start, goal, self.config.reference)
-        target = None if stop == "initial" else (1.0 + self.config.eps) * reference_length
-        bounds = tuple(float(m) for m in milestones)
+        arguments.check_seed(seed)
+        if stop == "initial":
+            target = None
+        else:
+            if reference_length is None:
+                reference_length = compute_reference(self.occ, start, goal, self.config.reference)
+            target = (1.0 + self.config.eps) * reference_length
+        bounds = tuple(map(float, milestones)) if milestones else ()
         return run.Query(start, goal, target, bounds, keep_tree, reference_length,
                          self.setup_time, self.sampler.fallback_uniform)  # fmt: skip
 
@@ -240,15 +168,8 @@ def plan(
     keep_tree: bool = False,
 ) -> PlanResult:
     """Plan once from ``start`` to ``goal``: ``Planner(grid, planner, heatmap=heatmap,
-    config=config, sampler=sampler).solve(start, goal, stop=stop, ...)``.
-
-    ``grid`` ``(H, W)`` occupancy (nonzero = obstacle, ``grid[y, x]``); ``start``, ``goal``
-    continuous ``(x, y)`` pixels; ``planner`` one of :data:`PLANNERS` (all but RRT* sample
-    ``heatmap``, or a prebuilt ``sampler``); every setting in ``config`` (default
-    :class:`PlannerConfig`; :data:`FASTEST` our fastest); ``stop`` ``'initial'`` or
-    ``'optimal'`` (cost <= (1 + eps) x ``reference_length``, None: ``config.reference``
-    computed); ``seed`` an int >= 0 or a tuple of them. Arguments and errors: :class:`Planner`
-    and :meth:`Planner.solve`. Returns a :class:`PlanResult`."""
+    config=config, sampler=sampler).solve(start, goal, stop=stop, ...)`` (arguments, errors
+    and the :class:`PlanResult` returned: :class:`Planner` and :meth:`Planner.solve`)."""
     p = Planner(grid, planner, heatmap=heatmap, config=config, sampler=sampler)
     return p.solve(start, goal, stop=stop, reference_length=reference_length, seed=seed,
                    milestones=milestones, keep_tree=keep_tree)  # fmt: skip

@@ -24,18 +24,8 @@ from numba import njit
 
 from vnrrt.grid import cell_center, point_to_cell
 from vnrrt.planners.collision import polyline_length, segment_free
-from vnrrt.search import any_angle_length, any_angle_path, astar
-
-__all__ = [
-    "any_angle_length",
-    "any_angle_path",
-    "astar_length",
-    "reference_length",
-    "taut_length",
-    "taut_path",
-]
-
-KINDS = ("astar", "any_angle", "taut")
+from vnrrt.planners.config import REFERENCES
+from vnrrt.search import any_angle_length, astar
 
 
 def _cells(start, goal) -> tuple[tuple[int, int], tuple[int, int]]:
@@ -98,4 +88,4 @@ def reference_length(occ: np.ndarray, start, goal, kind: str = "astar") -> float
         return any_angle_length(occ, start, goal)
     if kind == "taut":
         return taut_length(occ, start, goal)
-    raise ValueError(f"unknown reference {kind!r}; use one of {KINDS}")
+    raise ValueError(f"unknown reference {kind!r}; use one of {REFERENCES}")

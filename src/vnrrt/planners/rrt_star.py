@@ -7,22 +7,15 @@ Extend (choose the cheapest collision-free parent among the near nodes), Rewire 
 near nodes through the new node, propagating the cost change to their descendants), then
 try to connect the new node to the goal point.
 
-**Informed** (Gammell et al., 2014), when ``Params.informed``: once a solution of cost
-``c_best`` exists, samples come from the ellipse with foci start and goal and major axis
-``c_best`` (:func:`vnrrt.planners.samplers.informed_point`), and nodes that cannot improve
-the solution are skipped: a near node ``q`` with ``|q - start| + |q - goal| > c_best`` is no
-parent or rewiring candidate, and a new node whose cost-to-come plus its straight line to the
-goal exceeds ``c_best`` is not added (no path through it can be better).
-
-**Gaps**, when ``Draws.gap_share > 0``: after ``Draws.gap_after`` iterations, that share of
-the samples is drawn from the map's narrow-passage cells (:mod:`.gaps`; found then, by
-:func:`with_gaps`, inside the run), inside the ellipse once informed sampling applies.
-
-**Refinement**, when ``Params.refine > 0``: once a solution exists, that share of the
-iterations is a local move on the best path (or, ``refine_branches`` of them, on a promising
-branch) instead of a sample (:mod:`.refine`). **Pulled parents**, when
-``Params.pull_parents``: the chosen parent of a new node is replaced by its furthest ancestor
-that sees the node (:func:`pull_up`, Theta*'s any-angle rule).
+The options (their meaning: :class:`vnrrt.planners.PlannerConfig`): **informed**
+(Gammell et al., 2014), once a solution of cost ``c_best`` exists, samples inside the
+ellipse of ``c_best`` (:func:`.samplers.any_point`) and skips a near node ``q`` with ``|q -
+start| + |q - goal| > c_best`` as parent or rewiring candidate, and a new node whose
+cost-to-come plus its straight line to the goal exceeds ``c_best``; **gaps** draw a share
+of the samples from the narrow-passage cells, found inside the run (:func:`with_gaps`);
+**refine** makes a share of the iterations local moves on the best path (:mod:`.refine`);
+**pull_parents** replaces a new node's parent by its furthest ancestor that sees it
+(:func:`pull_up`).
 
 The tree lives in preallocated arrays (:mod:`.tree`); positions are continuous ``(x, y)``
 pixels, costs are path lengths in pixels from the start. The goal, once connected, is a
@@ -42,14 +35,8 @@ from vnrrt.planners import spatial
 from vnrrt.planners.collision import segment_free
 from vnrrt.planners.gaps import gap_cells
 from vnrrt.planners.refine import AT_REST, IMPROVED, refine_step
-from vnrrt.planners.samplers import NO_CELLS, any_point, next_double
-from vnrrt.planners.tree import (
-    PARENT,
-    add_node,
-    best_cost,
-    record,
-    reparent,
-)
+from vnrrt.planners.samplers import Draws, any_point, next_double
+from vnrrt.planners.tree import PARENT, add_node, best_cost, record, reparent
 
 RUNNING, MILESTONE_HIT, TREE_FULL = 0, 1, 2  # return codes of :func:`grow`
 
@@ -75,23 +62,6 @@ class Params(NamedTuple):
     refine: float = 0.0
     pull_parents: bool = False
     refine_branches: float = 0.0
-
-
-class Draws(NamedTuple):
-    """The sampler: heatmap draw probability ``mix``, cumulative weights ``cdf`` over flat
-    pixels and the last pixel with weight (see :mod:`.samplers`); the gap sampler: its share
-    ``gap_share`` of the samples, the widest passage ``gap_width`` (cells), the iterations
-    ``gap_after`` before its first draw, and the first ``n_gaps`` flat indices of
-    ``gap_cells`` it draws from (:mod:`.gaps`; ``n_gaps`` -1: not found yet, 0: none)."""
-
-    mix: float
-    cdf: np.ndarray
-    last: int
-    gap_share: float = 0.0
-    gap_width: int = 8
-    gap_after: int = 0
-    gap_cells: np.ndarray = NO_CELLS
-    n_gaps: int = 0
 
 
 @njit(cache=True)
@@ -231,9 +201,8 @@ def near_radius(n, p):
 def sample(rng, h, w, draws, p, c_best):
     """Sample: the sampler's (or the gap sampler's) draw, inside the informed ellipse once
     a solution exists (:func:`vnrrt.planners.samplers.any_point`)."""
-    d = draws
-    return any_point(rng, h, w, d.mix, d.cdf, d.last, d.gap_share, d.gap_cells, d.n_gaps,
-                     p.informed and c_best < np.inf, p.sx, p.sy, p.gx, p.gy, c_best)  # fmt: skip
+    ellipse = (p.informed and c_best < np.inf, p.sx, p.sy, p.gx, p.gy, c_best)
+    return any_point(rng, h, w, draws, ellipse)
 
 
 @njit(cache=True)

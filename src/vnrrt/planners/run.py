@@ -1,21 +1,19 @@
-"""One timed planner run on a validated query: the run's settings, its tree's arrays, the
-compiled loop that grows the tree (:func:`grow_tree`) and the :class:`PlanResult` built from it.
+"""One timed planner run on a checked query: the run's settings and tree arrays, the compiled
+loop that grows the tree (:func:`grow_tree`) and the :class:`PlanResult` built from it.
 
 Coordinates follow :mod:`vnrrt.grid`: ``occ`` is the ``(H, W)`` uint8 grid indexed
 ``occ[y, x]`` (nonzero = obstacle), points are continuous ``(x, y)`` pixels, lengths pixels,
 times seconds on ``time.perf_counter``'s clock.
 
-The clock starts before the straight start-goal segment is tested (when ``straight_first``)
-and stops when the stop rule or a budget is met and a grown tree's path and trace are taken
-out of it (as OMPL's ``solve()`` builds its solution path). A free straight segment that
-meets the stop rule is the exact optimum: the run ends there, its result a two-node tree.
-Otherwise the tree grows in one compiled call (:func:`grow_tree`): chunks of
-:func:`vnrrt.planners.rrt_star.grow` (first :data:`FIRST_CHUNK` iterations, doubling up to
-:data:`MAX_CHUNK`), the budgets checked and the stop bounds' first-pass times taken between
-chunks; it returns to Python only when the run is over or the tree's arrays are full (then
-enlarged, and the call made again). The tree's arrays are allocated (or emptied for reuse by
-the next run of the same planner) before the clock starts, as OMPL's ``setup()`` is outside
-its ``solve()`` times; growing them is inside.
+The clock starts before the straight start-goal segment is tested (when ``straight_first``;
+a free segment that meets the stop rule is the exact optimum and ends the run, a two-node
+tree) and stops when the stop rule or a budget is met and the path and trace are taken out
+of the tree (as OMPL's ``solve()`` builds its solution path). The tree grows in one compiled
+call: chunks of :func:`vnrrt.planners.rrt_star.grow` (:data:`FIRST_CHUNK` iterations first,
+doubling up to :data:`MAX_CHUNK`), the budgets checked and the bounds' first-pass times
+taken between chunks; it returns to Python when the run is over or the tree's arrays are
+full (then enlarged, inside the clock). The arrays are allocated or emptied before the
+clock starts, as OMPL's ``setup()`` is outside its ``solve()`` times.
 """
 
 from __future__ import annotations
@@ -33,13 +31,13 @@ from vnrrt.planners import tree as nodes
 from vnrrt.planners.clock import monotonic
 from vnrrt.planners.config import PlannerConfig
 from vnrrt.planners.result import Milestone, PlanResult
-from vnrrt.planners.rrt_star import TREE_FULL, Draws, Params
-from vnrrt.planners.samplers import NO_CELLS, Sampler
+from vnrrt.planners.rrt_star import TREE_FULL, Params
+from vnrrt.planners.samplers import Draws, Sampler
 from vnrrt.planners.seeding import rng_state
 
 FIRST_CAPACITY = 4096  # tree nodes allocated first; doubled when full (up to the budget)
 FIRST_CHUNK, MAX_CHUNK = 64, 4096  # iterations per chunk; budgets checked between
-SOLVED, MAX_ITERATIONS, MAX_SECONDS = 3, 4, 5  # return codes of :func:`drive` (or TREE_FULL)
+SOLVED, MAX_ITERATIONS, MAX_SECONDS = 3, 4, 5  # return codes of :func:`grow_tree` (or TREE_FULL)
 REASONS = {SOLVED: "solved", MAX_ITERATIONS: "max_iterations", MAX_SECONDS: "max_seconds"}
 
 
@@ -93,22 +91,25 @@ class Tree:
 
 
 class Setup:
-    """What every run of one planner on one map shares, made once (as OMPL's ``setup()``):
-    the budgets and, from the first tree run on, the core's settings (:attr:`params`,
-    :class:`~vnrrt.planners.rrt_star.Params`, the query's start and goal left at 0), the
-    sampler as the core reads it (:attr:`draws`) and the tree's arrays (:meth:`fresh`; one
-    run at a time)."""
+    """What every run of one planner on one map shares (as OMPL's ``setup()``), made when
+    the first run needs it (a straight answer needs none): the core's settings
+    (:attr:`params`, :class:`~vnrrt.planners.rrt_star.Params`, the query's start and goal
+    left at 0), the sampler as the core reads it (:attr:`draws`) and the tree's arrays
+    (:meth:`fresh`; one run at a time)."""
 
     def __init__(self, occ: np.ndarray, cfg: PlannerConfig, sampler: Sampler):
         self.occ, self.cfg, self.sampler = occ, cfg, sampler
-        self.max_iterations, self.max_seconds = int(cfg.max_iterations), float(cfg.max_seconds)
-        self.trace_capacity, self.straight_first = int(cfg.trace_capacity), cfg.straight_first
-        self.bucket = max(min(cfg.eta, max(occ.shape)) / 2, 1.0)  # an unlimited step: the map
         self._tree: Tree | None = None
 
     @functools.cached_property
+    def bucket(self) -> float:
+        """The bucket grid's side (pixels): half the steer step (an unlimited step: the
+        map's), at least a pixel."""
+        return max(min(self.cfg.eta, max(self.occ.shape)) / 2, 1.0)
+
+    @functools.cached_property
     def params(self) -> Params:
-        """The core's settings (made by the first tree run: a straight answer needs none)."""
+        """The core's settings (the config's and the map's gamma)."""
         cfg = self.cfg
         return Params(
             eta=float(cfg.eta),
@@ -126,20 +127,17 @@ class Setup:
 
     @functools.cached_property
     def draws(self) -> tuple:
-        """The sampler and the gap sampler as the core reads them (a plain :class:`Draws`)."""
-        cfg, sampler = self.cfg, self.sampler
-        cdf = sampler.cdf if sampler.cdf.size else np.zeros(1)
-        share = float(cfg.gap_share)  # the gap cells pending (-1) when used: found in the run
-        return tuple(Draws(float(sampler.draw_mix), cdf, max(sampler.last, 0), share,
-                           int(cfg.gap_width), int(cfg.gap_after), NO_CELLS,
-                           -1 if share > 0 else 0))  # fmt: skip
+        """The sampler and the gap sampler as the core reads them (a plain :class:`Draws`;
+        the gap cells, when used, found in the run)."""
+        cfg = self.cfg
+        return tuple(self.sampler.draws(cfg.gap_share, cfg.gap_width, cfg.gap_after))
 
     def fresh(self) -> Tree:
         """An empty tree: allocated (:data:`FIRST_CAPACITY` nodes, or the budget's) by the
         first run, emptied by the next ones (kept as large as it grew)."""
         if self._tree is None:
-            capacity = min(self.max_iterations + 2, FIRST_CAPACITY)
-            self._tree = Tree(capacity, self.occ.shape, self.bucket, self.trace_capacity)
+            capacity = min(self.cfg.max_iterations + 2, FIRST_CAPACITY)
+            self._tree = Tree(capacity, self.occ.shape, self.bucket, self.cfg.trace_capacity)
         self._tree.reset()
         return self._tree
 
@@ -159,8 +157,8 @@ def run(occ: np.ndarray, query: Query, *, planner: str, setup: Setup, seed) -> P
     """The timed run of ``query`` (module doc) with ``setup``'s settings and arrays, sampling
     from the xoshiro256** generator seeded by ``seed`` (:func:`.seeding.rng_state`)."""
     (sx, sy), (gx, gy) = query.start, query.goal
-    target, d, spent = query.target, -1.0, 0.0
-    if setup.straight_first:
+    target, d, spent, cfg = query.target, -1.0, 0.0, setup.cfg
+    if cfg.straight_first:
         t0 = time.perf_counter()
         d = rrt_star.straight_cost(occ, sx, sy, gx, gy)  # -1: blocked
         spent = time.perf_counter() - t0
@@ -173,14 +171,14 @@ def run(occ: np.ndarray, query: Query, *, planner: str, setup: Setup, seed) -> P
     times, iters = np.full(len(stops), math.nan), np.full(len(stops), -1, np.int64)
     state = np.array([FIRST_CHUNK, 0, 1], np.int64)  # chunk, bounds passed, plant
     t0 = time.perf_counter() - spent
-    limits = (math.inf if target is None else float(target), setup.max_iterations,
-              setup.max_seconds, t0)  # fmt: skip
+    limits = (math.inf if target is None else float(target), int(cfg.max_iterations),
+              float(cfg.max_seconds), t0)  # fmt: skip
     while True:  # after a full tree, the gap cells found in the call are found again (same)
         code, *arrays = grow_tree(occ, *tree.flat, rng, setup.draws, stops, tuple(params),
                                   tuple(first), limits, state, times, iters)  # fmt: skip
         if code != TREE_FULL:
             break
-        tree.enlarge(setup.max_iterations)
+        tree.enlarge(cfg.max_iterations)
     elapsed = time.perf_counter() - t0
     reached = dict(zip(stops.tolist(), zip(times.tolist(), iters.tolist()), strict=True))
     return result(tree, planner, query, reason=REASONS[code], reached=reached,
@@ -290,7 +288,7 @@ def straight_result(planner: str, d: float, found: float, query: Query) -> PlanR
     length ``d`` from start to goal: the tree is the root and the goal joined to it (one
     segment test). The cost is ``d``, equal to the polyline length of the path (both are
     libm's ``hypot``)."""
-    path = np.array((query.start, query.goal))
+    path, keep, bounds = np.array((query.start, query.goal)), query.keep_tree, query.bounds
     return PlanResult(
         planner=planner,
         success=True,
@@ -308,9 +306,11 @@ def straight_result(planner: str, d: float, found: float, query: Query) -> PlanR
         trace_costs=np.array((d,)),
         reference_length=query.reference_length,
         target_cost=query.target,
-        milestones=tuple(Milestone(b, found, 0) if d <= b else Milestone(b) for b in query.bounds),
+        milestones=tuple(Milestone(b, found, 0) if d <= b else Milestone(b) for b in bounds)
+        if bounds
+        else (),
         fallback_uniform=query.fallback_uniform,
         setup_time=query.setup_time,
-        tree_points=path.copy() if query.keep_tree else None,
-        tree_parents=np.array((-1, 0), np.int64) if query.keep_tree else None,
+        tree_points=path.copy() if keep else None,
+        tree_parents=np.array((-1, 0), np.int64) if keep else None,
     )

@@ -1,35 +1,27 @@
 """Samplers for the RRT* core: uniform, heatmap (NRRT*/VNRRT*) and masked (M-VNRRT*).
 
 Every sampler is the same small piece of data, a :class:`Sampler`, read by one compiled
-function, :func:`sample_point`: with probability ``mix`` a point is drawn from the
-heatmap (a pixel with probability proportional to its weight, then a uniform point
-inside that pixel), otherwise uniformly from the whole map ``[0, W) x [0, H)``
-(obstacles included, as in Algorithm 1). The uniform sampler is ``mix = 0``.
-
-* ``uniform`` (RRT*): ``mix = 0``.
-* ``heatmap`` (NRRT* with a path heatmap, VNRRT* with a vertex heatmap; Algorithm 2):
-  weights = the heatmap, ``mix = 0.5`` by default.
-* ``masked`` (M-VNRRT*): weights = the heatmap with values below ``tau`` set to zero.
-
-Informed sampling (:func:`informed_point`, used by the core once a solution exists when
-``informed`` is set) draws the same way but inside the ellipse of the points through which a
-shorter path can run.
-
-The **gap sampler** (:func:`gap_point`, any planner, ``PlannerConfig.gap_share``) draws a
-share of the samples from the map's narrow-passage cells (:mod:`.gaps`) instead;
-:func:`any_point` is the one draw the core makes.
+draw, :func:`any_point`: with probability ``mix`` a point is drawn from the heatmap (a pixel
+with probability proportional to its weight, then a uniform point inside that pixel),
+otherwise uniformly from the whole map ``[0, W) x [0, H)`` (obstacles included, as in
+Algorithm 1). ``uniform`` (RRT*) is ``mix = 0``; ``heatmap`` (NRRT* with a path heatmap,
+VNRRT* with a vertex heatmap; Algorithm 2) weighs pixels by the heatmap; ``masked``
+(M-VNRRT*) by the heatmap with values below ``tau`` set to zero. The same draw serves
+informed sampling (inside the ellipse of the points through which a shorter path can run)
+and the gap sampler (a share of the samples from the narrow-passage cells of :mod:`.gaps`).
 
 If no positive weight is left, the sampler falls back to uniform (no heatmap draws) and sets
 ``fallback_uniform``. Huge or tiny weights are scaled by a power of two before they are summed
 (the draws stay those of the given weights). Randomness comes from a xoshiro256** generator
-whose 4-word ``uint64`` state is seeded as :class:`numpy.random.SeedSequence` seeds it
-(:func:`vnrrt.planners.seeding.rng_state`); no global state.
+seeded as :class:`numpy.random.SeedSequence` seeds it (:func:`.seeding.rng_state`).
 """
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
@@ -39,6 +31,23 @@ from vnrrt.planners.seeding import rng_state
 
 _INV_2_53 = 1.0 / 9007199254740992.0
 NO_CELLS = np.zeros(1, np.int64)  # the gap cells of a sampler without (or not yet with) any
+
+
+class Draws(NamedTuple):
+    """A sampler as the compiled draw reads it: heatmap draw probability ``mix``, cumulative
+    weights ``cdf`` over flat pixels and the last pixel with weight; the gap sampler: its
+    share ``gap_share`` of the samples, the widest passage ``gap_width`` (cells), the
+    iterations ``gap_after`` before its first draw, and the first ``n_gaps`` flat indices of
+    ``gap_cells`` it draws from (:mod:`.gaps`; ``n_gaps`` -1: not found yet, 0: none)."""
+
+    mix: float
+    cdf: np.ndarray
+    last: int
+    gap_share: float = 0.0
+    gap_width: int = 8
+    gap_after: int = 0
+    gap_cells: np.ndarray = NO_CELLS
+    n_gaps: int = 0
 
 
 @njit(cache=True, inline="always")
@@ -84,15 +93,28 @@ class Sampler:
     fallback_uniform: bool = False
     tau: float | None = None
 
-    @property
-    def draw_mix(self) -> float:
-        """Probability that a sample is a heatmap draw: ``mix``, or 0 without weights."""
-        return 0.0 if self.fallback_uniform or self.last < 0 else self.mix
+    def draws(self, gap_share=0.0, gap_width=8, gap_after=0, cells=None) -> Draws:
+        """This sampler as the compiled draw reads it, with the gap sampler's settings and
+        flat ``cells`` (None: pending, found by the run when ``gap_share > 0``). Without
+        weights (uniform, or after a fallback) no heatmap draw is made (``mix`` 0)."""
+        mix = 0.0 if self.fallback_uniform or self.last < 0 else float(self.mix)
+        cdf = self.cdf if self.cdf.size else np.zeros(1)
+        n = (-1 if gap_share > 0 else 0) if cells is None else cells.size
+        cells = NO_CELLS if cells is None or cells.size == 0 else cells
+        return Draws(mix, cdf, max(self.last, 0), float(gap_share), int(gap_width),
+                     int(gap_after), cells, n)  # fmt: skip
 
 
 def uniform_sampler(shape: tuple[int, int]) -> Sampler:
-    """Uniform sampler over the ``(H, W)`` map."""
-    return Sampler("uniform", 0.0, np.zeros(0), -1, (int(shape[0]), int(shape[1])))
+    """Uniform sampler over the ``(H, W)`` map (one per shape: it holds nothing else)."""
+    return _uniform((int(shape[0]), int(shape[1])))
+
+
+@functools.lru_cache(maxsize=64)
+def _uniform(shape: tuple[int, int]) -> Sampler:
+    no_weights = np.zeros(0)
+    no_weights.flags.writeable = False
+    return Sampler("uniform", 0.0, no_weights, -1, shape)
 
 
 def heatmap_sampler(
@@ -151,20 +173,16 @@ def _below(v, hi):
 
 
 @njit(cache=True, inline="always")
-def _heat_point(s, w, cdf, last):
-    """A pixel drawn with probability proportional to its weight, then a uniform point in it."""
-    u = next_double(s) * cdf[last]
-    i = min(np.searchsorted(cdf, u, side="right"), last)
+def _pixel_point(s, w, d, gap):
+    """A uniform point of a pixel of a ``W`` wide map drawn from the sampler ``d``: one of the
+    first ``d.n_gaps`` gap cells, uniformly, when ``gap``, else a pixel with probability
+    proportional to its weight."""
+    if gap:
+        i = d.gap_cells[min(int(next_double(s) * d.n_gaps), d.n_gaps - 1)]
+    else:
+        i = min(np.searchsorted(d.cdf, next_double(s) * d.cdf[d.last], side="right"), d.last)
     px, py = float(i % w), float(i // w)
     return _below(px + next_double(s), px + 1.0), _below(py + next_double(s), py + 1.0)
-
-
-@njit(cache=True, inline="always")
-def sample_point(s, h, w, mix, cdf, last):
-    """One sample ``(x, y)`` in pixels (see module doc); ``s`` is the rng state."""
-    if mix > 0.0 and next_double(s) < mix:
-        return _heat_point(s, w, cdf, last)
-    return _below(next_double(s) * w, float(w)), _below(next_double(s) * h, float(h))
 
 
 INFORMED_TRIES = 64  # uniform draws until one lies in both the ellipse and the map
@@ -216,62 +234,33 @@ def ellipse_uniform(s, h, w, sx, sy, gx, gy, c_best):
 
 
 @njit(cache=True, inline="always")
-def informed_point(s, h, w, mix, cdf, last, sx, sy, gx, gy, c_best):
-    """One informed sample: with probability ``mix`` a heatmap draw conditioned on the ellipse
-    (rejection, at most :data:`HEATMAP_TRIES` draws; when all fall outside, the heatmap has
-    next to no mass in the ellipse and the sample is uniform there instead), otherwise a
-    uniform point of the ellipse inside the map (:func:`ellipse_uniform`)."""
-    if mix > 0.0 and next_double(s) < mix:
-        for _ in range(HEATMAP_TRIES):
-            x, y = _heat_point(s, w, cdf, last)
-            if in_ellipse(x, y, sx, sy, gx, gy, c_best):
-                return x, y
-    return ellipse_uniform(s, h, w, sx, sy, gx, gy, c_best)
-
-
-@njit(cache=True, inline="always")
-def _cell_point(s, w, cells, n):
-    """A uniform point of a cell drawn uniformly from the first ``n`` flat indices of
-    ``cells``."""
-    i = cells[min(int(next_double(s) * n), n - 1)]
-    px, py = float(i % w), float(i // w)
-    return _below(px + next_double(s), px + 1.0), _below(py + next_double(s), py + 1.0)
-
-
-@njit(cache=True, inline="always")
-def gap_point(s, h, w, cells, n, informed, sx, sy, gx, gy, c_best):
-    """One draw of the gap sampler: a uniform point of a cell drawn uniformly from the ``n``
-    gap cells (flat indices ``cells``, :mod:`.gaps`); when ``informed``, conditioned on the
-    ellipse as :func:`informed_point` conditions a heatmap draw (at most
-    :data:`HEATMAP_TRIES` draws, then a uniform point of the ellipse)."""
-    if not informed:
-        return _cell_point(s, w, cells, n)
-    for _ in range(HEATMAP_TRIES):
-        x, y = _cell_point(s, w, cells, n)
-        if in_ellipse(x, y, sx, sy, gx, gy, c_best):
+def any_point(s, h, w, d, ellipse):
+    """One sample ``(x, y)`` (pixels) of the sampler ``d`` (a :class:`Draws`), ``s`` the rng
+    state: with probability ``d.gap_share`` (when gap cells exist) a gap sampler's draw, else
+    with probability ``d.mix`` a heatmap draw, else a uniform point of the map. ``ellipse``
+    is ``(informed, sx, sy, gx, gy, c_best)``: when informed, a gap or heatmap draw is
+    conditioned on the ellipse of ``c_best`` (rejection: at most :data:`HEATMAP_TRIES`
+    draws; when all fall outside, there is next to no mass in the ellipse and the sample is
+    uniform there instead) and a uniform point is one of the ellipse inside the map
+    (:func:`ellipse_uniform`). A share or mix of 0 spends no random number on its choice."""
+    informed, sx, sy, gx, gy, c_best = ellipse
+    gap = d.gap_share > 0.0 and d.n_gaps > 0 and next_double(s) < d.gap_share
+    if not gap and not (d.mix > 0.0 and next_double(s) < d.mix):
+        if informed:
+            return ellipse_uniform(s, h, w, sx, sy, gx, gy, c_best)
+        return _below(next_double(s) * w, float(w)), _below(next_double(s) * h, float(h))
+    for _ in range(HEATMAP_TRIES if informed else 1):
+        x, y = _pixel_point(s, w, d, gap)
+        if not informed or in_ellipse(x, y, sx, sy, gx, gy, c_best):
             return x, y
     return ellipse_uniform(s, h, w, sx, sy, gx, gy, c_best)
 
 
-@njit(cache=True, inline="always")
-def any_point(s, h, w, mix, cdf, last, share, cells, n, informed, sx, sy, gx, gy, c_best):
-    """One sample of a planner: with probability ``share`` (when ``n`` gap cells exist) a
-    :func:`gap_point`, else the sampler's draw (:func:`informed_point` when ``informed``,
-    else :func:`sample_point`). With ``share`` 0 no random number is spent on the choice,
-    so the draws are those of the sampler alone."""
-    if share > 0.0 and n > 0 and next_double(s) < share:
-        return gap_point(s, h, w, cells, n, informed, sx, sy, gx, gy, c_best)
-    if informed:
-        return informed_point(s, h, w, mix, cdf, last, sx, sy, gx, gy, c_best)
-    return sample_point(s, h, w, mix, cdf, last)
-
-
 @njit(cache=True)
-def _draw(s, count, h, w, mix, cdf, last, share, cells, n, informed, sx, sy, gx, gy, c_best):
+def _draw(s, count, h, w, d, ellipse):
     out = np.empty((count, 2))
     for k in range(count):
-        p = any_point(s, h, w, mix, cdf, last, share, cells, n, informed, sx, sy, gx, gy, c_best)
-        out[k, 0], out[k, 1] = p
+        out[k, 0], out[k, 1] = any_point(s, h, w, d, ellipse)
     return out
 
 
@@ -281,26 +270,8 @@ def draw(sampler: Sampler, n: int, seed=0, ellipse=None, gaps=None) -> np.ndarra
     costs ``c_best``; ``gaps=(share, cells)`` mixes in the gap sampler's draws as a planner
     with ``gap_share=share`` does (``cells``: flat indices, :func:`vnrrt.planners.gaps.
     gap_cells`)."""
-    h, w = sampler.shape
-    cdf = sampler.cdf if sampler.cdf.size else np.zeros(1)
     (sx, sy), (gx, gy), c_best = ellipse if ellipse is not None else ((0, 0), (0, 0), 0.0)
-    share, cells = gaps if gaps is not None else (0.0, NO_CELLS)
-    cells = np.asarray(cells, np.int64)
-    return _draw(
-        rng_state(seed),
-        int(n),
-        h,
-        w,
-        sampler.draw_mix,
-        cdf,
-        max(sampler.last, 0),
-        float(share),
-        cells if cells.size else NO_CELLS,
-        int(cells.size),
-        ellipse is not None,
-        float(sx),
-        float(sy),
-        float(gx),
-        float(gy),
-        float(c_best),
-    )
+    share, cells = (gaps[0], np.asarray(gaps[1], np.int64)) if gaps is not None else (0.0, None)
+    d = sampler.draws(share, cells=cells)
+    ends = (ellipse is not None, float(sx), float(sy), float(gx), float(gy), float(c_best))
+    return _draw(rng_state(seed), int(n), *sampler.shape, d, ends)
