@@ -3,11 +3,15 @@ with a trained network.
 
   vnrrt plan --map FILE [--instance NAME|I] [--start X,Y --goal X,Y] [--planner P]
              [--heatmap FILE | --checkpoint CKPT [--pad]] [--tau T] [--stop initial|optimal]
-             [--set KEY=VALUE ...] [--out plan.png]
+             [--config NAME|FILE] [--set KEY=VALUE ...] [--out plan.png]
   vnrrt plan --map M.map --scen M.map.scen [--scen-rows 0,5,10-19] [--longest N]
              [--limit N] [--planner P --checkpoint CKPT] ...  (a batch: one row per query)
   vnrrt predict --checkpoint CKPT --map FILE [--instance NAME|I | --start X,Y --goal X,Y]
              [--pad] --out heatmap.npy|heatmap.png
+
+Planner settings: --config user (the default: conf/planner/user.yaml, our fastest settings
+with budgets scaled with the map's free cells), fastest, default (the paper's protocol) or a
+planner YAML file; the output names the configuration and the budget it used.
 
 Maps: .npy occupancy (H, W), nonzero = obstacle; .npz: a dataset shard or the pipeline's
 named maps (with --instance, an index or a named map's name, e.g. u_trap); .png, read the
@@ -74,27 +78,46 @@ def _overrides(pairs: list[str]) -> dict:
     return out
 
 
-def _planner_config(path: Path | None, pairs: list[str]):
-    """``PlannerConfig`` defaults (identical to ``conf/planner/default.yaml``, tested), or a
-    planner YAML, with ``--set`` overrides."""
+RULES = {"max_iterations": "iterations_per_free_cell", "max_seconds": "seconds_per_free_cell"}
+
+
+def _planner_config(config: str | None, pairs: list[str]):
+    """The planner settings and how to name them: ``--config`` a name of ``conf/planner/``
+    (``user``, the default when none is given; ``fastest``; ``default``, the paper's
+    protocol) or a planner YAML file, then the ``--set`` overrides. A budget set
+    (``max_iterations``, ``max_seconds``) is the budget: the budget rule's constant for it
+    is turned off unless set too."""
+    from vnrrt.config import CONF_DIR
     from vnrrt.planners import PlannerConfig
 
-    cfg = PlannerConfig()
-    if path is not None:
-        import yaml
-        from omegaconf import OmegaConf
+    name = config or "user"
+    if (CONF_DIR / "planner" / f"{name}.yaml").is_file() and "/" not in name and "." not in name:
+        cfg, label = PlannerConfig.named(name), f"{name} (conf/planner/{name}.yaml)"
+    else:
+        cfg, label = _config_file(Path(name)), name
+    changes = _overrides(pairs)
+    for budget, rule in RULES.items():
+        if budget in changes and rule not in changes:
+            changes[rule] = None
+    return cfg.replace(**changes), label + "".join(f" --set {a}" for a in pairs)
 
-        from vnrrt.config import section
 
-        if not path.is_file():
-            raise UsageError(f"--config {path} not found")
-        try:
-            node = OmegaConf.create(yaml.safe_load(path.read_text()) or {})
-        except yaml.YAMLError as err:
-            first = str(err).splitlines()[0]
-            raise UsageError(f"--config {path} is not valid YAML: {first}") from None
-        cfg = section({"planner": node}, "planner", PlannerConfig)
-    return cfg.replace(**_overrides(pairs))
+def _config_file(path: Path):
+    """The planner settings of a YAML file (every key of ``conf/planner/default.yaml``)."""
+    import yaml
+    from omegaconf import OmegaConf
+
+    from vnrrt.config import section
+    from vnrrt.planners import PlannerConfig
+
+    if not path.is_file():
+        raise UsageError(f"--config {path} not found (nor a name in conf/planner/)")
+    try:
+        node = OmegaConf.create(yaml.safe_load(path.read_text()) or {})
+    except yaml.YAMLError as err:
+        first = str(err).splitlines()[0]
+        raise UsageError(f"--config {path} is not valid YAML: {first}") from None
+    return section({"planner": node}, "planner", PlannerConfig)
 
 
 def _endpoints(args, inst: dict) -> tuple[tuple, tuple]:
@@ -136,9 +159,12 @@ def add_plan_command(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--tau", type=float, help="mask threshold of m_vnrrt_star, in (0, 1]")
     p.add_argument("--stop", choices=("initial", "optimal"), default="initial")
     p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--config", type=Path, help="planner YAML (default: the package defaults)")
+    p.add_argument("--config", help="a planner YAML file, or a name in conf/planner/: user "
+                   "(the default: our fastest settings, budgets scaled with the map's free "
+                   "cells), fastest, default (the paper's protocol)")  # fmt: skip
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
-                   help="override a planner setting, e.g. --set eta=5 (repeatable)")  # fmt: skip
+                   help="override a planner setting, e.g. --set eta=5 (repeatable); "
+                   "--set max_iterations=N or max_seconds=S fixes that budget")  # fmt: skip
     p.add_argument("--out", type=Path, help="write a PNG of map, heatmap, tree and path")
     p.set_defaults(func=run_plan)
 
@@ -173,9 +199,9 @@ def run_plan(args: argparse.Namespace) -> int:
 
     if args.tau is not None and not 0.0 < args.tau <= 1.0:
         raise UsageError(f"--tau {args.tau}: must be in (0, 1] (heatmaps are probabilities)")
-    cfg = _planner_config(args.config, args.set)
+    cfg, label = _planner_config(args.config, args.set)
     if args.scen is not None:
-        return run_scen(args, cfg if args.tau is None else cfg.replace(tau=args.tau))
+        return run_scen(args, cfg if args.tau is None else cfg.replace(tau=args.tau), label)
     for flag in ("scen_rows", "longest", "limit"):
         if getattr(args, flag) is not None:
             raise UsageError(f"--{flag.replace('_', '-')} needs --scen")
@@ -192,6 +218,7 @@ def run_plan(args: argparse.Namespace) -> int:
                   seed=args.seed, config=cfg if args.tau is None else cfg.replace(tau=args.tau),
                   keep_tree=args.out is not None)  # fmt: skip
     print(result.summary())
+    print(f"config: {label}")
     try:
         a, t = astar_length(inst["grid"], start, goal), any_angle_length(inst["grid"], start, goal)
         ratio = f"{result.cost / a:.4f}" if a > 0 else "n/a (start and goal coincide)"

@@ -28,7 +28,7 @@ from vnrrt.grid import GridError, as_occupancy, as_point
 from vnrrt.planners import run
 from vnrrt.planners.arguments import check_stop_target
 from vnrrt.planners.collision import segment_free
-from vnrrt.planners.config import PLANNERS, PlannerConfig
+from vnrrt.planners.config import PLANNERS, USER, PlannerConfig
 from vnrrt.planners.reference import reference_length as compute_reference
 from vnrrt.planners.result import PlanResult
 from vnrrt.planners.samplers import Sampler, heatmap_sampler, uniform_sampler
@@ -49,8 +49,9 @@ def _known(planner: str) -> None:
 
 
 def _config(config: PlannerConfig | None) -> PlannerConfig:
+    """``config`` validated; None gives :data:`~vnrrt.planners.config.USER`."""
     if config is None:
-        return PlannerConfig()
+        return USER
     if not isinstance(config, PlannerConfig):
         raise TypeError(f"config must be a PlannerConfig, got {type(config).__name__}")
     config.validate()  # remembered: a frozen config is checked once
@@ -133,7 +134,10 @@ class Planner:
         planner: ``'rrt_star'`` (uniform), ``'nrrt_star'`` / ``'vnrrt_star'`` (heatmap
             sampler, Algorithm 2) or ``'m_vnrrt_star'`` (heatmap masked below ``config.tau``).
         heatmap: ``(H, W)`` non-negative sampling weights, needed by all but RRT*.
-        config: every setting (default :class:`PlannerConfig`).
+        config: every setting. Default :data:`~vnrrt.planners.USER`
+            (``conf/planner/user.yaml``: our fastest settings, budgets scaled with the map's
+            free cells F: ``max(200000, ceil(50 F))`` iterations, ``max(30, 0.0002 F)``
+            seconds); the paper's protocol is :meth:`PlannerConfig.paper`.
         sampler: a sampler already built by :func:`make_sampler` for this planner, map and
             config (then no ``heatmap``); checked against them.
 
@@ -245,7 +249,9 @@ def plan(
     ``grid`` ``(H, W)`` occupancy (nonzero = obstacle, ``grid[y, x]``); ``start``, ``goal``
     continuous ``(x, y)`` pixels; ``planner`` one of :data:`PLANNERS` (all but RRT* sample
     ``heatmap``, or a prebuilt ``sampler``); every setting in ``config`` (default
-    :class:`PlannerConfig`; :data:`FASTEST` our fastest); ``stop`` ``'initial'`` or
+    :data:`USER`, ``conf/planner/user.yaml``: our fastest settings with budgets scaled with
+    the map's free area, see :class:`Planner`; :meth:`PlannerConfig.paper` the paper's
+    protocol); ``stop`` ``'initial'`` or
     ``'optimal'`` (cost <= (1 + eps) x ``reference_length``, None: ``config.reference``
     computed); ``seed`` an int >= 0 or a tuple of them. Arguments and errors: :class:`Planner`
     and :meth:`Planner.solve`. Returns a :class:`PlanResult`."""

@@ -97,11 +97,15 @@ class Setup:
     the budgets and, from the first tree run on, the core's settings (:attr:`params`,
     :class:`~vnrrt.planners.rrt_star.Params`, the query's start and goal left at 0), the
     sampler as the core reads it (:attr:`draws`) and the tree's arrays (:meth:`fresh`; one
-    run at a time)."""
+    run at a time). The budgets are the map's (:meth:`PlannerConfig.budgets`: fixed, or
+    scaled with its free cells by the budget rule)."""
 
     def __init__(self, occ: np.ndarray, cfg: PlannerConfig, sampler: Sampler):
         self.occ, self.cfg, self.sampler = occ, cfg, sampler
-        self.max_iterations, self.max_seconds = int(cfg.max_iterations), float(cfg.max_seconds)
+        scaled = cfg.iterations_per_free_cell is not None or cfg.seconds_per_free_cell is not None
+        free = occ.size - np.count_nonzero(occ) if scaled else 0
+        self.max_iterations, self.max_seconds = cfg.budgets(free)
+        self.budget = (self.max_iterations, self.max_seconds)
         self.trace_capacity, self.straight_first = int(cfg.trace_capacity), cfg.straight_first
         self.bucket = max(min(cfg.eta, max(occ.shape)) / 2, 1.0)  # an unlimited step: the map
         self._tree: Tree | None = None
@@ -165,7 +169,7 @@ def run(occ: np.ndarray, query: Query, *, planner: str, setup: Setup, seed) -> P
         d = rrt_star.straight_cost(occ, sx, sy, gx, gy)  # -1: blocked
         spent = time.perf_counter() - t0
         if d >= 0 and (target is None or d <= target):
-            return straight_result(planner, d, spent, query)
+            return straight_result(planner, d, spent, query, setup.budget)
     stops, rng = stop_bounds(query), rng_state(seed)
     tree = setup.fresh()  # allocated (or emptied) before the clock starts, as OMPL's setup()
     params = setup.params._replace(sx=sx, sy=sy, gx=gx, gy=gy)
@@ -184,7 +188,7 @@ def run(occ: np.ndarray, query: Query, *, planner: str, setup: Setup, seed) -> P
     elapsed = time.perf_counter() - t0
     reached = dict(zip(stops.tolist(), zip(times.tolist(), iters.tolist()), strict=True))
     return result(tree, planner, query, reason=REASONS[code], reached=reached,
-                  elapsed=elapsed, arrays=arrays)  # fmt: skip
+                  elapsed=elapsed, arrays=arrays, budget=setup.budget)  # fmt: skip
 
 
 def stop_bounds(query: Query) -> np.ndarray:
@@ -253,9 +257,11 @@ def result(
     reached: dict[float, tuple[float, int]],
     elapsed: float,
     arrays: list,
+    budget: tuple[int, float],
 ) -> PlanResult:
     """The :class:`PlanResult` of a finished run; ``reached[bound] = (seconds, iteration)``;
-    ``arrays``: its path, segment lengths, trace iterations and costs (:func:`grow_tree`)."""
+    ``arrays``: its path, segment lengths, trace iterations and costs (:func:`grow_tree`);
+    ``budget``: its ``(max_iterations, max_seconds)``."""
     c, t = tree.counters, tree.tree
     n, g, k = int(c.nodes[0]), int(c.goal[0]), int(c.trace_len[0])
     path, segs, trace_iterations, trace_costs = arrays
@@ -280,16 +286,18 @@ def result(
         milestones=tuple(Milestone(b, *reached[b]) for b in query.bounds),
         fallback_uniform=query.fallback_uniform,
         setup_time=query.setup_time,
+        budget=budget,
         tree_points=t.pts[:n].copy() if query.keep_tree else None,
         tree_parents=t.links[:n, nodes.PARENT].copy() if query.keep_tree else None,
     )
 
 
-def straight_result(planner: str, d: float, found: float, query: Query) -> PlanResult:
-    """The result of a run answered after ``found`` seconds by the free straight segment of
-    length ``d`` from start to goal: the tree is the root and the goal joined to it (one
-    segment test). The cost is ``d``, equal to the polyline length of the path (both are
-    libm's ``hypot``)."""
+def straight_result(planner: str, d: float, found: float, query: Query,
+                    budget: tuple[int, float]) -> PlanResult:  # fmt: skip
+    """The result of a run (with ``budget``) answered after ``found`` seconds by the free
+    straight segment of length ``d`` from start to goal: the tree is the root and the goal
+    joined to it (one segment test). The cost is ``d``, equal to the polyline length of the
+    path (both are libm's ``hypot``)."""
     path = np.array((query.start, query.goal))
     return PlanResult(
         planner=planner,
@@ -311,6 +319,7 @@ def straight_result(planner: str, d: float, found: float, query: Query) -> PlanR
         milestones=tuple(Milestone(b, found, 0) if d <= b else Milestone(b) for b in query.bounds),
         fallback_uniform=query.fallback_uniform,
         setup_time=query.setup_time,
+        budget=budget,
         tree_points=path.copy() if query.keep_tree else None,
         tree_parents=np.array((-1, 0), np.int64) if query.keep_tree else None,
     )
