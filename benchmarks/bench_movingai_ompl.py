@@ -11,15 +11,17 @@ motions checked every 0.5 px, OMPL's default settings, stopping at the same cost
 (their first solutions counted too). Per run, seconds from the start of the planner's own
 solve to its first solution and to the bound, as each measures them (ours:
 ``time_to_first``/``time_to_stop``; OMPL: timed in C++ from the start of ``solve()``).
-Runs alternate per query and seed, ours first; a path that crosses an obstacle cell would be
-flagged ``clipped``.
+Runs alternate per query and seed, ours first. A final path that crosses an obstacle cell
+(OMPL checks motions every 0.5 px, so its paths may cut a corner of a cell) is ``clipped``:
+counted as its planner reported it, and counted per planner and map.
 
 Reported per map, for the first solution and for the bound: runs solved within the budget
 by ours and by each OMPL planner, the medians over all runs (an unsolved run counts at the
 budget, the median then marked ``>`` when it is one: a lower bound), OMPL's best planner
 (least median), the ratio of medians (best OMPL / ours; ``>``: a lower bound) and the
 paired median speed-up over the runs that OMPL's best solved (its time / ours on the same
-query and seed; ``-`` where it solved none).
+query and seed; ``-`` where it solved none), and the clipped runs (ours first, then OMPL's
+in the table's order).
 
     python benchmarks/bench_movingai_ompl.py [--limit 5] [--longest 5] [--seeds 3]
         [--maps ...] [--out benchmarks/results/bench_movingai_ompl.txt]
@@ -100,7 +102,7 @@ def section(per_map: dict, key: str, names: tuple, limit: float) -> list[str]:
     """The table to ``key`` ('first' or 'stop') over ``names`` (OMPL's) beside ours."""
     head = (f"{'map':<11}{'ours':>7}" + "".join(f"{SHORT[n]:>7}" for n in names)
             + f"{'ours ms':>10}" + "".join(f"{SHORT[n] + ' ms':>10}" for n in names)
-            + f"{'best':>7}{'ratio':>9}{'paired':>12}")  # fmt: skip
+            + f"{'best':>7}{'ratio':>9}{'paired':>12}  clipped")  # fmt: skip
     lines = [head]
     for name, runs in per_map.items():
         n = len(runs["ours"])
@@ -111,7 +113,8 @@ def section(per_map: dict, key: str, names: tuple, limit: float) -> list[str]:
         ratio = f"{'>' if bl else ''}{b / o:.3g}x" if o > 0 and not ol else "-"
         line = f"{name:<11}" + "".join(f"{f'{k}/{n}':>7}" for k in solved)
         line += "".join(cell(*meds[p], 10) for p in ("ours", *names))
-        line += f"{SHORT[best]:>7}{ratio:>9}{paired(runs['ours'], runs[best], key):>12}"
+        line += f"{SHORT[best]:>7}{ratio:>9}{paired(runs['ours'], runs[best], key):>12}  "
+        line += "/".join(str(sum(r["clipped"] for r in runs[p])) for p in ("ours", *names))
         lines.append(line)
     return lines
 
