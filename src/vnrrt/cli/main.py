@@ -47,6 +47,7 @@ from vnrrt.cli.inputs import (
     load_instance,
 )
 from vnrrt.cli.scen import add_scen_arguments, run_scen
+from vnrrt.cli.settings import planner_config
 from vnrrt.cli.stage import EXIT_BUDGET, EXIT_HELP, EXIT_OK, run_reporting
 
 __all__ = ["UsageError", "build_parser", "load_heatmap", "load_instance", "main"]
@@ -60,64 +61,6 @@ def _point(text: str) -> tuple[float, float]:
     if not (math.isfinite(x) and math.isfinite(y)):
         raise argparse.ArgumentTypeError(f"expected finite X,Y, got {text!r}")
     return x, y
-
-
-def _overrides(pairs: list[str]) -> dict:
-    """``key=value`` strings parsed as YAML scalars (``eta=5`` gives 5, ``gamma=null``)."""
-    import yaml
-
-    out = {}
-    for pair in pairs:
-        key, sep, value = pair.partition("=")
-        if not sep or not key:
-            raise UsageError(f"--set expects key=value, got {pair!r}")
-        try:
-            out[key.strip()] = yaml.safe_load(value)
-        except yaml.YAMLError:
-            raise UsageError(f"--set {pair!r}: the value is not a number or word") from None
-    return out
-
-
-RULES = {"max_iterations": "iterations_per_free_cell", "max_seconds": "seconds_per_free_cell"}
-
-
-def _planner_config(config: str | None, pairs: list[str]):
-    """The planner settings and how to name them: ``--config`` a name of ``conf/planner/``
-    (``user``, the default when none is given; ``fastest``; ``default``, the paper's
-    protocol) or a planner YAML file, then the ``--set`` overrides. A budget set
-    (``max_iterations``, ``max_seconds``) is the budget: the budget rule's constant for it
-    is turned off unless set too."""
-    from vnrrt.config import CONF_DIR
-    from vnrrt.planners import PlannerConfig
-
-    name = config or "user"
-    if (CONF_DIR / "planner" / f"{name}.yaml").is_file() and "/" not in name and "." not in name:
-        cfg, label = PlannerConfig.named(name), f"{name} (conf/planner/{name}.yaml)"
-    else:
-        cfg, label = _config_file(Path(name)), name
-    changes = _overrides(pairs)
-    for budget, rule in RULES.items():
-        if budget in changes and rule not in changes:
-            changes[rule] = None
-    return cfg.replace(**changes), label + "".join(f" --set {a}" for a in pairs)
-
-
-def _config_file(path: Path):
-    """The planner settings of a YAML file (every key of ``conf/planner/default.yaml``)."""
-    import yaml
-    from omegaconf import OmegaConf
-
-    from vnrrt.config import section
-    from vnrrt.planners import PlannerConfig
-
-    if not path.is_file():
-        raise UsageError(f"--config {path} not found (nor a name in conf/planner/)")
-    try:
-        node = OmegaConf.create(yaml.safe_load(path.read_text()) or {})
-    except yaml.YAMLError as err:
-        first = str(err).splitlines()[0]
-        raise UsageError(f"--config {path} is not valid YAML: {first}") from None
-    return section({"planner": node}, "planner", PlannerConfig)
 
 
 def _endpoints(args, inst: dict) -> tuple[tuple, tuple]:
@@ -199,7 +142,7 @@ def run_plan(args: argparse.Namespace) -> int:
 
     if args.tau is not None and not 0.0 < args.tau <= 1.0:
         raise UsageError(f"--tau {args.tau}: must be in (0, 1] (heatmaps are probabilities)")
-    cfg, label = _planner_config(args.config, args.set)
+    cfg, label = planner_config(args.config, args.set)
     if args.scen is not None:
         return run_scen(args, cfg if args.tau is None else cfg.replace(tau=args.tau), label)
     for flag in ("scen_rows", "longest", "limit"):
