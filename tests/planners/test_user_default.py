@@ -13,6 +13,7 @@ from hypothesis import strategies as st
 
 from vnrrt.cli.main import main
 from vnrrt.config import CONF_DIR, compose, load_params, section
+from vnrrt.pipeline.evaluation import trials_settings
 from vnrrt.planners import FASTEST, USER, Planner, PlannerConfig, plan
 from vnrrt.planners.config import PlannerConfig as ConfigClass
 
@@ -117,6 +118,7 @@ def test_the_pipeline_keeps_the_papers_protocol():
         if f.name != "max_seconds":  # the scale group sets the time budget
             assert getattr(composed, f.name) == getattr(paper, f.name), f.name
     assert composed.straight_first is False and composed.informed is False
+    assert trials_settings(load_params())["planner"] == composed  # the trials stages' settings
     user = section(compose(["planner=user"]), "planner", ConfigClass)  # selectable too
     assert user.iterations_per_free_cell == USER.iterations_per_free_cell
 
