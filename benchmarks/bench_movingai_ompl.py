@@ -19,10 +19,10 @@ bound, where the final path is the one that reached it), and counted per planner
 Reported per map, for the first solution and for the bound: runs solved within the budget
 by ours and by each OMPL planner, the medians over all runs (an unsolved run counts at the
 budget, the median then marked ``>`` when it is one: a lower bound), OMPL's best planner
-(least median), the ratio of medians (best OMPL / ours; ``>``: a lower bound) and the
-paired median speed-up over the runs that OMPL's best solved (its time / ours on the same
-query and seed; ``-`` where it solved none), and the clipped runs (ours first, then OMPL's
-in the table's order).
+(least median; of equal ones, the one that solved most), the ratio of medians (best OMPL /
+ours; ``>``: a lower bound) and the paired median speed-up over the runs that OMPL's best
+solved (its time / ours on the same query and seed; ``-`` where it solved none), and the
+clipped runs (ours first, then OMPL's in the table's order).
 
     python benchmarks/bench_movingai_ompl.py [--limit 5] [--longest 5] [--seeds 3]
         [--maps ...] [--out benchmarks/results/bench_movingai_ompl.txt]
@@ -109,7 +109,8 @@ def section(per_map: dict, key: str, names: tuple, limit: float) -> list[str]:
         n = len(runs["ours"])
         solved = [sum(not math.isnan(r[key]) for r in runs[p]) for p in ("ours", *names)]
         meds = {p: median(runs[p], key, limit) for p in ("ours", *names)}
-        best = min(names, key=lambda p: (meds[p][0], p))
+        wins = dict(zip(("ours", *names), solved, strict=True))
+        best = min(names, key=lambda p: (meds[p][0], -wins[p], p))  # ties: the most solved
         (o, ol), (b, bl) = meds["ours"], meds[best]
         ratio = f"{'>' if bl else ''}{b / o:.3g}x" if o > 0 and not ol else "-"
         line = f"{name:<11}" + "".join(f"{f'{k}/{n}':>7}" for k in solved)
