@@ -29,6 +29,7 @@ SOURCE = HERE / "harness.cpp"
 BUILD = HERE / "build"  # git ignores it (.gitignore beside this file)
 INSTALL = "apt-get install -y libompl-dev g++  (Debian/Ubuntu, as root)"
 PLANNERS = ("RRTstar", "InformedRRTstar", "BITstar", "ABITstar", "AITstar")
+RRT_CONNECT = "RRTConnect"  # also answered: not an optimizer, it stops at its first solution
 
 
 class HarnessError(RuntimeError):
@@ -139,8 +140,9 @@ class Harness:
 
     def solve(self, planner: str, start, goal, bound: float, limit: float,
               step: float = 0.0) -> NativeRun:  # fmt: skip
-        """Run ``planner`` (one of :data:`PLANNERS`) until its cost reaches ``bound`` px or
-        ``limit`` s; ``step``: the Steer range of the RRT* planners (0: OMPL's default)."""
+        """Run ``planner`` (one of :data:`PLANNERS`, or :data:`RRT_CONNECT`) until its cost
+        reaches ``bound`` px or ``limit`` s (RRT-Connect: until its first solution);
+        ``step``: the Steer range of the RRT planners (0: OMPL's default)."""
         numbers = (step, *start, *goal, bound, limit)
         line = f"solve {planner} " + " ".join(repr(float(v)) for v in numbers) + "\n"
         self._proc.stdin.write(line)

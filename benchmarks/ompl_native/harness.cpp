@@ -6,7 +6,8 @@
 //                          (index y * W + x), the grid of the following solves; answers
 //                          "mapped H W"
 //   solve PLANNER RANGE SX SY GX GY BOUND LIMIT
-//                          PLANNER: RRTstar InformedRRTstar BITstar ABITstar AITstar;
+//                          PLANNER: RRTstar InformedRRTstar BITstar ABITstar AITstar, or
+//                          RRTConnect (not an optimizer: it stops at its first solution);
 //                          RANGE: the Steer step in pixels (0: OMPL's default);
 //                          start and goal (x, y) in pixels; BOUND: the cost threshold at
 //                          which the planner stops; LIMIT: seconds
@@ -28,6 +29,7 @@
 #include <ompl/geometric/planners/informedtrees/AITstar.h>
 #include <ompl/geometric/planners/informedtrees/BITstar.h>
 #include <ompl/geometric/planners/rrt/InformedRRTstar.h>
+#include <ompl/geometric/planners/rrt/RRTConnect.h>
 #include <ompl/geometric/planners/rrt/RRTstar.h>
 #include <ompl/util/Console.h>
 #include <ompl/util/RandomNumbers.h>
@@ -79,7 +81,17 @@ static ob::PlannerPtr make(const ob::SpaceInformationPtr &si, std::function<doub
 }
 
 static ob::PlannerPtr planner_named(const std::string &name, const ob::SpaceInformationPtr &si,
-                                    double range, std::function<double()> &best) {
+                                    const ob::ProblemDefinitionPtr &pdef, double range,
+                                    std::function<double()> &best) {
+    if (name == "RRTConnect") {  // no bestCost(): the length of the solution it has found
+        auto p = std::make_shared<og::RRTConnect>(si);
+        if (range > 0) p->setRange(range);
+        best = [pdef] {
+            return pdef->hasExactSolution() ? pdef->getSolutionPath()->length()
+                                            : std::numeric_limits<double>::infinity();
+        };
+        return p;
+    }
     if (name == "RRTstar" || name == "InformedRRTstar") {
         auto p = name == "RRTstar" ? make<og::RRTstar>(si, best) : make<og::InformedRRTstar>(si, best);
         if (range > 0) std::static_pointer_cast<og::RRTstar>(p)->setRange(range);
@@ -117,7 +129,7 @@ static std::string solve(const Grid &g, std::istringstream &in) {
     objective->setCostThreshold(ob::Cost(bound));
     pdef->setOptimizationObjective(objective);
     std::function<double()> best;
-    auto planner = planner_named(name, si, range, best);
+    auto planner = planner_named(name, si, pdef, range, best);
     planner->setProblemDefinition(pdef);
     planner->setup();
     const double setup = since(t_setup);

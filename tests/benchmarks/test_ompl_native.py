@@ -37,6 +37,22 @@ def test_the_harness_stops_within_one_percent_of_the_exact_optimum(binary, plann
     assert abs(r.cost / exact - 1) <= 0.01
 
 
+def test_rrt_connect_stops_at_its_first_solution(binary):
+    """RRT-Connect (no optimizer) answers with its first path: a path round the wall from
+    start to goal, its length reported, at least the exact optimum less OMPL's 0.5 px hair;
+    with an unreachable bound its first solution still ends the run, well before the limit."""
+    grid = np.zeros((60, 60), np.uint8)
+    grid[10:50, 30] = 1
+    s, e = (10.5, 30.5), (50.5, 30.5)
+    exact = any_angle_path(grid, s, e)[1]
+    with ompl_native.Harness(binary, seed=3) as native:
+        native.set_map(grid)
+        r = native.solve(ompl_native.RRT_CONNECT, s, e, bound=0.5 * exact, limit=10.0)
+    assert 0 < r.first < 10.0 and math.isnan(r.stop)
+    np.testing.assert_allclose(r.path[[0, -1]], [s, e])
+    assert r.cost == pytest.approx(polyline_length(r.path), rel=1e-9) and r.cost > 0.99 * exact
+
+
 def test_a_query_before_any_map_is_an_error(binary):
     with (
         ompl_native.Harness(binary) as native,

@@ -165,7 +165,9 @@ def test_uninformed_runs_add_nodes_that_cannot_improve_the_first_solution():
     that cannot improve the first solution."""
     fm = named_map("u_trap", 200)
     s, g = fm.starts[0] + 0.5, fm.goals[0] + 0.5
-    first = plan(fm.grid, s, g, stop="initial", keep_tree=True, seed=2)
+    first = plan(
+        fm.grid, s, g, stop="initial", keep_tree=True, seed=2, config=PlannerConfig.paper()
+    )  # the paper's settings, as r's
     r = plan(fm.grid, s, g, stop="optimal", reference_length=math.dist(s, g), keep_tree=True,
              seed=2, config=PlannerConfig(max_iterations=4000, eps=0.0))  # fmt: skip
     np.testing.assert_array_equal(r.tree_points[: first.tree_size], first.tree_points)

@@ -3,11 +3,15 @@ with a trained network.
 
   vnrrt plan --map FILE [--instance NAME|I] [--start X,Y --goal X,Y] [--planner P]
              [--heatmap FILE | --checkpoint CKPT [--pad]] [--tau T] [--stop initial|optimal]
-             [--set KEY=VALUE ...] [--out plan.png]
+             [--config NAME|FILE] [--set KEY=VALUE ...] [--out plan.png]
   vnrrt plan --map M.map --scen M.map.scen [--scen-rows 0,5,10-19] [--longest N]
              [--limit N] [--planner P --checkpoint CKPT] ...  (a batch: one row per query)
   vnrrt predict --checkpoint CKPT --map FILE [--instance NAME|I | --start X,Y --goal X,Y]
              [--pad] --out heatmap.npy|heatmap.png
+
+Planner settings: --config user (the default: conf/planner/user.yaml, our fastest settings
+with budgets scaled with the map's free cells), fastest, default (the paper's protocol) or a
+planner YAML file; the output names the configuration and the budget it used.
 
 Maps: .npy occupancy (H, W), nonzero = obstacle; .npz: a dataset shard or the pipeline's
 named maps (with --instance, an index or a named map's name, e.g. u_trap); .png, read the
@@ -43,6 +47,7 @@ from vnrrt.cli.inputs import (
     load_instance,
 )
 from vnrrt.cli.scen import add_scen_arguments, run_scen
+from vnrrt.cli.settings import planner_config
 from vnrrt.cli.stage import EXIT_BUDGET, EXIT_HELP, EXIT_OK, run_reporting
 
 __all__ = ["UsageError", "build_parser", "load_heatmap", "load_instance", "main"]
@@ -56,45 +61,6 @@ def _point(text: str) -> tuple[float, float]:
     if not (math.isfinite(x) and math.isfinite(y)):
         raise argparse.ArgumentTypeError(f"expected finite X,Y, got {text!r}")
     return x, y
-
-
-def _overrides(pairs: list[str]) -> dict:
-    """``key=value`` strings parsed as YAML scalars (``eta=5`` gives 5, ``gamma=null``)."""
-    import yaml
-
-    out = {}
-    for pair in pairs:
-        key, sep, value = pair.partition("=")
-        if not sep or not key:
-            raise UsageError(f"--set expects key=value, got {pair!r}")
-        try:
-            out[key.strip()] = yaml.safe_load(value)
-        except yaml.YAMLError:
-            raise UsageError(f"--set {pair!r}: the value is not a number or word") from None
-    return out
-
-
-def _planner_config(path: Path | None, pairs: list[str]):
-    """``PlannerConfig`` defaults (identical to ``conf/planner/default.yaml``, tested), or a
-    planner YAML, with ``--set`` overrides."""
-    from vnrrt.planners import PlannerConfig
-
-    cfg = PlannerConfig()
-    if path is not None:
-        import yaml
-        from omegaconf import OmegaConf
-
-        from vnrrt.config import section
-
-        if not path.is_file():
-            raise UsageError(f"--config {path} not found")
-        try:
-            node = OmegaConf.create(yaml.safe_load(path.read_text()) or {})
-        except yaml.YAMLError as err:
-            first = str(err).splitlines()[0]
-            raise UsageError(f"--config {path} is not valid YAML: {first}") from None
-        cfg = section({"planner": node}, "planner", PlannerConfig)
-    return cfg.replace(**_overrides(pairs))
 
 
 def _endpoints(args, inst: dict) -> tuple[tuple, tuple]:
@@ -136,9 +102,12 @@ def add_plan_command(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--tau", type=float, help="mask threshold of m_vnrrt_star, in (0, 1]")
     p.add_argument("--stop", choices=("initial", "optimal"), default="initial")
     p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--config", type=Path, help="planner YAML (default: the package defaults)")
+    p.add_argument("--config", help="a planner YAML file, or a name in conf/planner/: user "
+                   "(the default: our fastest settings, budgets scaled with the map's free "
+                   "cells), fastest, default (the paper's protocol)")  # fmt: skip
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
-                   help="override a planner setting, e.g. --set eta=5 (repeatable)")  # fmt: skip
+                   help="override a planner setting, e.g. --set eta=5 (repeatable); "
+                   "--set max_iterations=N or max_seconds=S fixes that budget")  # fmt: skip
     p.add_argument("--out", type=Path, help="write a PNG of map, heatmap, tree and path")
     p.set_defaults(func=run_plan)
 
@@ -173,9 +142,9 @@ def run_plan(args: argparse.Namespace) -> int:
 
     if args.tau is not None and not 0.0 < args.tau <= 1.0:
         raise UsageError(f"--tau {args.tau}: must be in (0, 1] (heatmaps are probabilities)")
-    cfg = _planner_config(args.config, args.set)
+    cfg, label = planner_config(args.config, args.set)
     if args.scen is not None:
-        return run_scen(args, cfg if args.tau is None else cfg.replace(tau=args.tau))
+        return run_scen(args, cfg if args.tau is None else cfg.replace(tau=args.tau), label)
     for flag in ("scen_rows", "longest", "limit"):
         if getattr(args, flag) is not None:
             raise UsageError(f"--{flag.replace('_', '-')} needs --scen")
@@ -192,6 +161,7 @@ def run_plan(args: argparse.Namespace) -> int:
                   seed=args.seed, config=cfg if args.tau is None else cfg.replace(tau=args.tau),
                   keep_tree=args.out is not None)  # fmt: skip
     print(result.summary())
+    print(f"config: {label}")
     try:
         a, t = astar_length(inst["grid"], start, goal), any_angle_length(inst["grid"], start, goal)
         ratio = f"{result.cost / a:.4f}" if a > 0 else "n/a (start and goal coincide)"

@@ -70,9 +70,10 @@ def _heat(args, grid: np.ndarray, s):
     return heatmap(args.checkpoint, grid, s.start, s.goal, target=target, pad=args.pad)
 
 
-def run_scen(args: argparse.Namespace, cfg) -> int:
+def run_scen(args: argparse.Namespace, cfg, label: str) -> int:
     """Plan the selected queries of ``args.scen`` on ``args.map``; print a row for each and
-    a summary; 0 when every planned query met the stop rule, else 1 (a budget was hit)."""
+    a summary naming the configuration (``label``) and its budget on the map; 0 when every
+    planned query met the stop rule, else 1 (a budget was hit)."""
     from vnrrt.maps.movingai import blocked_endpoint, check_scenarios, read_map, read_scen
     from vnrrt.planners import plan
 
@@ -107,9 +108,9 @@ def run_scen(args: argparse.Namespace, cfg) -> int:
         print(f"{s.line:>6} {cells} {'yes' if result.success else 'no':>6} "
               f"{result.cost:>9.3f} {s.optimal:>9.3f} {times[-1]:>9.2f}")  # fmt: skip
     median = f"{statistics.median(times):.2f} ms" if times else "n/a"
-    config = f"{args.config or 'package defaults'}{''.join(' --set ' + a for a in args.set)}"
+    iterations, seconds = cfg.budgets(int(np.count_nonzero(grid == 0)))
     print(f"summary: solved {solved} of {len(times)} planned ({skipped} skipped) of "
           f"{len(scenarios)} in {args.scen}; median time {median}; planner {args.planner}, "
-          f"stop {args.stop}, budget {cfg.max_iterations} iterations / {cfg.max_seconds:g} s, "
-          f"config {config}")  # fmt: skip
+          f"stop {args.stop}, budget {iterations} iterations / {seconds:g} s, "
+          f"config {label}")  # fmt: skip
     return EXIT_OK if solved == len(times) else EXIT_BUDGET

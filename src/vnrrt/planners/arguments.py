@@ -15,7 +15,7 @@ import numpy as np
 
 from vnrrt.grid import GridError, as_occupancy, as_point
 from vnrrt.planners.collision import segment_free
-from vnrrt.planners.config import PLANNERS, PlannerConfig
+from vnrrt.planners.config import PLANNERS, USER, PlannerConfig
 from vnrrt.planners.samplers import Sampler
 
 SAMPLER_KINDS = {"rrt_star": "uniform", "nrrt_star": "heatmap", "vnrrt_star": "heatmap",
@@ -32,10 +32,10 @@ def check_planner(planner) -> None:
 
 
 def checked_config(config) -> PlannerConfig:
-    """``config`` validated (None: the default :class:`PlannerConfig`); ``TypeError`` for
-    anything but a :class:`PlannerConfig`."""
+    """``config`` validated (None: the library's default, :data:`~vnrrt.planners.config.USER`,
+    ``conf/planner/user.yaml``); ``TypeError`` for anything but a :class:`PlannerConfig`."""
     if config is None:
-        return PlannerConfig()
+        return USER
     if type(config) is not PlannerConfig and not isinstance(config, PlannerConfig):
         raise TypeError(f"config must be a PlannerConfig, got {type(config).__name__}")
     config.validate()  # remembered: a frozen config is checked once

@@ -1,6 +1,9 @@
 """Planner settings: :class:`PlannerConfig`, whose defaults are ``conf/planner/default.yaml``
-(read here, written nowhere else), and :data:`FASTEST`, ``conf/planner/fastest.yaml`` (the
-Hydra option ``planner=fastest``). Lengths in pixels, times in seconds.
+(the paper's protocol, :meth:`PlannerConfig.paper`; read here, written nowhere else);
+:data:`FASTEST`, ``conf/planner/fastest.yaml`` (the Hydra option ``planner=fastest``); and
+:data:`USER`, ``conf/planner/user.yaml``: what :func:`vnrrt.planners.plan` and ``vnrrt plan``
+use when given no configuration (FASTEST's settings, budgets scaled with the map's free area:
+:meth:`PlannerConfig.budgets`). Lengths in pixels, times in seconds.
 
 The files are read with PyYAML by the readers of :mod:`vnrrt.config` (no Hydra here), from
 the repository's ``conf/`` or, in an installed wheel, its packaged copy;
@@ -75,7 +78,12 @@ class PlannerConfig:
             before it pay nothing for them.
         gap_width: widest passage (cells) whose cells the gap sampler draws.
         gap_after: iterations before the gap sampler's first draw.
-        max_iterations, max_seconds: budgets; hitting one is a recorded failure.
+        max_iterations, max_seconds: budgets; hitting one is a recorded failure. With the
+            budget rule on, the floors of the map's budgets (:meth:`budgets`).
+        iterations_per_free_cell, seconds_per_free_cell: the budget rule: on a map of F free
+            cells, ``max_iterations`` becomes ``max(max_iterations, ceil(k F))`` and
+            ``max_seconds`` ``max(max_seconds, k F)`` with ``k`` these (None: the budget is
+            fixed, as in the paper's protocol).
         trace_capacity: most points kept in the sparse cost-versus-iteration trace.
 
     Frozen: a config is changed by :meth:`replace`, which validates the copy, so a config
@@ -105,7 +113,39 @@ class PlannerConfig:
     gap_after: int
     max_iterations: int
     max_seconds: float
+    iterations_per_free_cell: float | None
+    seconds_per_free_cell: float | None
     trace_capacity: int
+
+    @classmethod
+    def paper(cls) -> PlannerConfig:
+        """The paper's protocol: ``conf/planner/default.yaml`` (the study's ``planner=default``),
+        fixed budgets."""
+        return cls()
+
+    @classmethod
+    def named(cls, option: str) -> PlannerConfig:
+        """The validated settings of ``conf/planner/<option>.yaml`` as Hydra composes the
+        option (``default``, ``fastest``, ``user``); :class:`PlannerConfigError` names an
+        unknown key, :class:`vnrrt.config.ConfigError` a missing file."""
+        values = config.conf_file("planner", option)
+        known = {f.name for f in dataclasses.fields(cls)}
+        unknown = sorted(set(values) - known)
+        if unknown:
+            raise PlannerConfigError(f"conf/planner/{option}.yaml: unknown setting(s) {unknown}")
+        return cls().replace(**values)
+
+    def budgets(self, free_cells: int) -> tuple[int, float]:
+        """``(max_iterations, max_seconds)`` of a run on a map of ``free_cells`` free cells:
+        the fixed budgets, or with the budget rule ``max(max_iterations,
+        ceil(iterations_per_free_cell x free_cells))`` and ``max(max_seconds,
+        seconds_per_free_cell x free_cells)``."""
+        iterations, seconds = int(self.max_iterations), float(self.max_seconds)
+        if self.iterations_per_free_cell is not None:
+            iterations = max(iterations, math.ceil(self.iterations_per_free_cell * free_cells))
+        if self.seconds_per_free_cell is not None:
+            seconds = max(seconds, self.seconds_per_free_cell * free_cells)
+        return iterations, seconds
 
     def validate(self) -> None:
         """Raise :class:`PlannerConfigError` naming the first invalid value."""
@@ -144,6 +184,9 @@ class PlannerConfig:
         self._check("gap_after", ok, "an integer in [0, 2^62]")
         ok = _integer(self.trace_capacity) and self.trace_capacity >= 2
         self._check("trace_capacity", ok, "an integer >= 2")
+        for name in ("iterations_per_free_cell", "seconds_per_free_cell"):
+            v = getattr(self, name)
+            self._check(name, v is None or (_finite(v) and v >= 0), "null or a number >= 0")
         self._check("tau", _finite(self.tau), "finite")
         self._check("taus", all(_finite(t) for t in self.taus), "finite values")
         object.__setattr__(self, "_valid", True)  # not a field: eq, repr and replace ignore it
@@ -178,6 +221,5 @@ def _finite(v) -> bool:
     return isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)
 
 
-FASTEST = PlannerConfig(
-    **config.conf_file("planner", "fastest")
-)  # our fastest settings, any planner
+FASTEST = PlannerConfig.named("fastest")  # our fastest settings, any planner, fixed budgets
+USER = PlannerConfig.named("user")  # plan()'s and `vnrrt plan`'s: FASTEST, scaled budgets

@@ -50,6 +50,8 @@ class PlanResult:
             uniformly instead.
         setup_time: seconds spent building the sampler (0 when a prebuilt one was given);
             not part of ``time_to_first`` / ``time_to_stop``.
+        budget: the run's ``(max_iterations, max_seconds)`` on its map (the configuration's
+            fixed budgets, or those of its budget rule: ``PlannerConfig.budgets``).
         tree_points, tree_parents: ``(N, 2)`` and ``(N,)`` (parent index, -1 for the
             root) when ``keep_tree`` was asked, else None.
     """
@@ -73,15 +75,17 @@ class PlanResult:
     milestones: tuple[Milestone, ...] = ()
     fallback_uniform: bool = False
     setup_time: float = 0.0
+    budget: tuple[int, float] | None = None
     tree_points: np.ndarray | None = field(default=None, repr=False)
     tree_parents: np.ndarray | None = field(default=None, repr=False)
 
     def summary(self) -> str:
-        """One line: planner, success, cost, iterations, nodes and times."""
+        """One line: planner, success, cost, iterations, nodes, times and budget."""
         ref = "" if self.reference_length is None else f" ref={self.reference_length:.2f}"
+        budget = "" if self.budget is None else f" budget={self.budget[0]} it/{self.budget[1]:g} s"
         return (
             f"{self.planner}: success={self.success} ({self.stop_reason}) cost={self.cost:.2f}"
             f"{ref} iterations={self.iterations} nodes={self.tree_size} "
             f"checks={self.collision_checks} first={self.time_to_first * 1e3:.2f} ms "
-            f"stop={self.time_to_stop * 1e3:.2f} ms"
+            f"stop={self.time_to_stop * 1e3:.2f} ms{budget}"
         )

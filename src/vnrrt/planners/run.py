@@ -92,14 +92,24 @@ class Tree:
 
 class Setup:
     """What every run of one planner on one map shares (as OMPL's ``setup()``), made when
-    the first run needs it (a straight answer needs none): the core's settings
-    (:attr:`params`, :class:`~vnrrt.planners.rrt_star.Params`, the query's start and goal
-    left at 0), the sampler as the core reads it (:attr:`draws`) and the tree's arrays
-    (:meth:`fresh`; one run at a time)."""
+    a run first needs it: the budgets (:attr:`budget`: fixed, or scaled with the map's free
+    cells by the budget rule, :meth:`PlannerConfig.budgets`) and, from the first tree run on
+    (a straight answer needs none), the core's settings (:attr:`params`,
+    :class:`~vnrrt.planners.rrt_star.Params`, the query's start and goal left at 0), the
+    sampler as the core reads it (:attr:`draws`) and the tree's arrays (:meth:`fresh`; one
+    run at a time)."""
 
     def __init__(self, occ: np.ndarray, cfg: PlannerConfig, sampler: Sampler):
         self.occ, self.cfg, self.sampler = occ, cfg, sampler
         self._tree: Tree | None = None
+
+    @functools.cached_property
+    def budget(self) -> tuple[int, float]:
+        """``(max_iterations, max_seconds)`` on this map (free cells counted only when the
+        config scales a budget with them)."""
+        cfg = self.cfg
+        scaled = cfg.iterations_per_free_cell is not None or cfg.seconds_per_free_cell is not None
+        return cfg.budgets(self.occ.size - np.count_nonzero(self.occ) if scaled else 0)
 
     @functools.cached_property
     def bucket(self) -> float:
@@ -136,7 +146,7 @@ class Setup:
         """An empty tree: allocated (:data:`FIRST_CAPACITY` nodes, or the budget's) by the
         first run, emptied by the next ones (kept as large as it grew)."""
         if self._tree is None:
-            capacity = min(self.cfg.max_iterations + 2, FIRST_CAPACITY)
+            capacity = min(self.budget[0] + 2, FIRST_CAPACITY)
             self._tree = Tree(capacity, self.occ.shape, self.bucket, self.cfg.trace_capacity)
         self._tree.reset()
         return self._tree
@@ -163,7 +173,7 @@ def run(occ: np.ndarray, query: Query, *, planner: str, setup: Setup, seed) -> P
         d = rrt_star.straight_cost(occ, sx, sy, gx, gy)  # -1: blocked
         spent = time.perf_counter() - t0
         if d >= 0 and (target is None or d <= target):
-            return straight_result(planner, d, spent, query)
+            return straight_result(planner, d, spent, query, setup.budget)
     stops, rng = stop_bounds(query), rng_state(seed)
     tree = setup.fresh()  # allocated (or emptied) before the clock starts, as OMPL's setup()
     params = setup.params._replace(sx=sx, sy=sy, gx=gx, gy=gy)
@@ -171,18 +181,19 @@ def run(occ: np.ndarray, query: Query, *, planner: str, setup: Setup, seed) -> P
     times, iters = np.full(len(stops), math.nan), np.full(len(stops), -1, np.int64)
     state = np.array([FIRST_CHUNK, 0, 1], np.int64)  # chunk, bounds passed, plant
     t0 = time.perf_counter() - spent
-    limits = (math.inf if target is None else float(target), int(cfg.max_iterations),
-              float(cfg.max_seconds), t0)  # fmt: skip
+    max_iterations, max_seconds = setup.budget
+    limits = (math.inf if target is None else float(target), int(max_iterations),
+              float(max_seconds), t0)  # fmt: skip
     while True:  # after a full tree, the gap cells found in the call are found again (same)
         code, *arrays = grow_tree(occ, *tree.flat, rng, setup.draws, stops, tuple(params),
                                   tuple(first), limits, state, times, iters)  # fmt: skip
         if code != TREE_FULL:
             break
-        tree.enlarge(cfg.max_iterations)
+        tree.enlarge(max_iterations)
     elapsed = time.perf_counter() - t0
     reached = dict(zip(stops.tolist(), zip(times.tolist(), iters.tolist()), strict=True))
     return result(tree, planner, query, reason=REASONS[code], reached=reached,
-                  elapsed=elapsed, arrays=arrays)  # fmt: skip
+                  elapsed=elapsed, arrays=arrays, budget=setup.budget)  # fmt: skip
 
 
 def stop_bounds(query: Query) -> np.ndarray:
@@ -251,9 +262,11 @@ def result(
     reached: dict[float, tuple[float, int]],
     elapsed: float,
     arrays: list,
+    budget: tuple[int, float],
 ) -> PlanResult:
     """The :class:`PlanResult` of a finished run; ``reached[bound] = (seconds, iteration)``;
-    ``arrays``: its path, segment lengths, trace iterations and costs (:func:`grow_tree`)."""
+    ``arrays``: its path, segment lengths, trace iterations and costs (:func:`grow_tree`);
+    ``budget``: its ``(max_iterations, max_seconds)``."""
     c, t = tree.counters, tree.tree
     n, g, k = int(c.nodes[0]), int(c.goal[0]), int(c.trace_len[0])
     path, segs, trace_iterations, trace_costs = arrays
@@ -278,16 +291,18 @@ def result(
         milestones=tuple(Milestone(b, *reached[b]) for b in query.bounds),
         fallback_uniform=query.fallback_uniform,
         setup_time=query.setup_time,
+        budget=budget,
         tree_points=t.pts[:n].copy() if query.keep_tree else None,
         tree_parents=t.links[:n, nodes.PARENT].copy() if query.keep_tree else None,
     )
 
 
-def straight_result(planner: str, d: float, found: float, query: Query) -> PlanResult:
-    """The result of a run answered after ``found`` seconds by the free straight segment of
-    length ``d`` from start to goal: the tree is the root and the goal joined to it (one
-    segment test). The cost is ``d``, equal to the polyline length of the path (both are
-    libm's ``hypot``)."""
+def straight_result(planner: str, d: float, found: float, query: Query,
+                    budget: tuple[int, float]) -> PlanResult:  # fmt: skip
+    """The result of a run (with ``budget``) answered after ``found`` seconds by the free
+    straight segment of length ``d`` from start to goal: the tree is the root and the goal
+    joined to it (one segment test). The cost is ``d``, equal to the polyline length of the
+    path (both are libm's ``hypot``)."""
     path, keep, bounds = np.array((query.start, query.goal)), query.keep_tree, query.bounds
     return PlanResult(
         planner=planner,
@@ -311,6 +326,7 @@ def straight_result(planner: str, d: float, found: float, query: Query) -> PlanR
         else (),
         fallback_uniform=query.fallback_uniform,
         setup_time=query.setup_time,
+        budget=budget,
         tree_points=path.copy() if keep else None,
         tree_parents=np.array((-1, 0), np.int64) if keep else None,
     )
