@@ -131,5 +131,5 @@ def test_a_stage_run_by_dvc_refuses_params_changed_since_validate(repo, work, tm
                          capture_output=True, text=True, timeout=120)  # fmt: skip
     assert out.returncode == 2 and "planner.eps: 0.01 -> 0.05" in out.stderr, out.stderr
     assert "dvc exp run --queue" in out.stderr and out.stderr.count("\n") == 1
-    # nothing written: data/ holds only the copied input data/paper
-    assert sorted(p.name for p in (dest / "data").iterdir()) == ["paper"]
+    # nothing written: data/ holds only the copied inputs data/movingai and data/paper
+    assert sorted(p.name for p in (dest / "data").iterdir()) == ["movingai", "paper"]
