@@ -19,3 +19,11 @@ def test_a_cpu_is_named_by_model_cores_and_vector_units(tmp_path):
 def test_without_cpuinfo_the_platform_names_the_cpu(tmp_path):
     text = describe(tmp_path / "missing")
     assert "cores" in text and not text.startswith(",")
+
+
+def test_trademarks_clock_and_core_count_are_left_out(tmp_path):
+    info = tmp_path / "cpuinfo"
+    intel = ("Intel(R) Xeon(R) Platinum 8375C CPU @ 2.90GHz", "Intel Xeon Platinum 8375C")
+    for model, name in (intel, ("AMD EPYC 7R13 48-Core Processor", "AMD EPYC 7R13")):
+        info.write_text(f"model name\t: {model}\nflags\t: avx2\n")
+        assert describe(info).startswith(f"{name}, ")

@@ -37,7 +37,7 @@ NET = {"_target_": NETWORK_CLASS, "encoder": "resnet18", "out_channels": 2, "in_
 def test_the_stage_runs_the_quick_subset_in_the_default_pipeline():
     entry = yaml.safe_load((REPO / "dvc.yaml").read_text())["stages"]["bench_maps"]
     assert entry["foreach"] == "${bench_maps.report}"
-    assert entry["do"]["cmd"] == "python stages/benchmark_maps.py --name ${item}"
+    assert entry["do"]["cmd"] == "python stages/bench_maps.py --name ${item}"
     default, cpu = compose(), compose(["scale=cpu"])
     assert default.scale.name == "quick" and list(default.bench_maps.report) == ["benchmark_maps"]
     quick = dict(default.bench_maps.maps)

@@ -36,6 +36,7 @@ from vnrrt.data.shards import shard_file
 from vnrrt.evaluation.noise import baseline_record
 from vnrrt.evaluation.table import SEEDED_COLUMNS, merge_parts
 from vnrrt.maps.config import DataConfig
+from vnrrt.studies.paper_comparison.report import VERDICT_KEYS
 
 SHARDS = Path("data/smoke/shards")
 # The session's pipeline runs at these values rather than conf/'s defaults, so that every test
@@ -192,8 +193,8 @@ def test_smoke_dvc_repro_end_to_end(workdir, tracking_server):
     assert (workdir / "reports/figures/ideas/quality_curve.png").stat().st_size > 10_000
     headline = json.loads((workdir / "reports/metrics/headline.json").read_text())
     # one verdict per testable claim; an untestable claim gets none in the counts
-    assert sum(headline["verdicts"].values()) + headline["untestable"] == 8
-    assert headline["testable"] == sum(headline["verdicts"].values())
+    counted = sum(headline[k] for k in VERDICT_KEYS.values())
+    assert counted + headline["untestable"] == 8 and headline["testable"] == counted
     client = MlflowClient(f"sqlite:///{workdir / 'mlflow.db'}")
     exp = client.get_experiment_by_name("vnrrt-smoke")
     runs = client.search_runs([exp.experiment_id])

@@ -6,18 +6,20 @@ from __future__ import annotations
 
 import os
 import platform
+import re
 from pathlib import Path
 
 
 def describe(cpuinfo: str | Path = "/proc/cpuinfo") -> str:
-    """``'AMD EPYC 9R14, 2 cores, avx512_bf16'``: the CPU model (``platform.processor()``
-    where ``cpuinfo`` is unreadable), the usable cores, ``avx512_bf16`` or ``avx2`` or
-    nothing."""
+    """``'AMD EPYC 9R14, 2 cores, avx512_bf16'``: the CPU model without trademarks, clock
+    and core count (``platform.processor()`` where ``cpuinfo`` is unreadable), the usable
+    cores, ``avx512_bf16`` or ``avx2`` or nothing."""
     try:
         text = Path(cpuinfo).read_text()
     except OSError:
         text = ""
     model = _field(text, "model name") or platform.processor() or "unknown CPU"
+    model = re.sub(r"\((R|TM|tm)\)|\bCPU\b|@ *[\d.]+ *GHz|\b\d+-Core Processor", "", model)
     flags = set(_field(text, "flags").split())
     simd = next((f for f in ("avx512_bf16", "avx2") if f in flags), "")
     try:

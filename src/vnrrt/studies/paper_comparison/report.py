@@ -60,15 +60,15 @@ HEADLINE_PLANNERS = {"rrt_star": "rrt", "nrrt_star": "nrrt", "vnrrt_star": "vnrr
 
 def headline(summary: dict, networks: dict, tau: float, machine: str | None = None) -> dict:
     """The few numbers of ``dvc metrics show`` (one line each under ~300 characters in a
-    terminal; the full tables are in the report and MLflow): the counts of verdicts on the
-    paper's testable claims (an untestable claim gets no verdict in the counts), each
-    network's mass near what it is for (a vertex network: the interior vertices; a path
+    terminal; the full tables are in the report and MLflow): the counts of verdicts
+    (:data:`VERDICT_KEYS`) on the paper's testable claims (an untestable claim gets no
+    verdict in the counts), each network's mass near what it is for (a vertex network: the interior vertices; a path
     network: the path) as a multiple of a uniform map's, the vertex networks'
     interior-vertex AP, the median planning time (ms) to the A*-relative optimum on random
     maps of RRT*, NRRT*, VNRRT* and M-VNRRT* at ``tau`` (``planner.tau``), and the
     ``machine`` whose timings these are (None: not recorded). ``networks``:
     ``predict.json``'s metrics per network."""
-    out: dict = {"verdicts": {}, "mass_x": {}, "opt_ms": {}, "interior_ap": {}}
+    out: dict = {"mass_x": {}, "opt_ms": {}, "interior_ap": {}}
     for net, m in networks.items():
         target = TARGET_MASKS[m["target"]]
         share, uniform = (
@@ -88,7 +88,7 @@ def headline(summary: dict, networks: dict, tau: float, machine: str | None = No
     testable = [r for r in rows if r["testability"]["testable"]]
     verdicts = [r["verdict"] for r in testable]  # one per testable claim; untestable: none
     for group in VERDICT_GROUPS:
-        out["verdicts"][VERDICT_KEYS[group]] = sum(v.startswith(group) for v in verdicts)
+        out[VERDICT_KEYS[group]] = sum(v.startswith(group) for v in verdicts)
     out["testable"], out["untestable"] = len(testable), len(rows) - len(testable)
     out["contradicting"] = sum(r["paper_data"] == CONTRADICTS for r in testable)
     return out | ({"machine": machine} if machine else {})

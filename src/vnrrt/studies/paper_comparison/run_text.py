@@ -81,7 +81,7 @@ def headline_metrics(summary: dict, headline: dict) -> dict[str, float]:
         for net, value in headline.get(key, {}).items():
             out[metric_name("random_maps", "heatmap", name, net)] = float(value)
     for key, name in VERDICT_COUNTS.items():
-        out[f"claims/count/{name}"] = float(headline["verdicts"].get(key, 0))
+        out[f"claims/count/{name}"] = float(headline.get(key, 0))
     out["claims/count/testable"] = float(headline["testable"])
     out["claims/count/contradicting_paper_data"] = float(headline["contradicting"])
     return out | claim_metrics(summary["claims"]["rows"])
