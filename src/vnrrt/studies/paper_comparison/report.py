@@ -64,9 +64,9 @@ def headline(summary: dict, networks: dict, tau: float, machine: str | None = No
     (:data:`VERDICT_KEYS`) on the paper's testable claims (an untestable claim gets no
     verdict in the counts), each network's mass near what it is for (a vertex network: the
     interior vertices; a path network: the path) as a multiple of a uniform map's, the
-    vertex networks' interior-vertex AP, the median planning time (ms) to the A*-relative optimum on random
-    maps of RRT*, NRRT*, VNRRT* and M-VNRRT* at ``tau`` (``planner.tau``), and the
-    ``machine`` whose timings these are (None: not recorded). ``networks``:
+    vertex networks' interior-vertex AP, the median planning time (ms) to the A*-relative
+    optimum on random maps of RRT*, NRRT*, VNRRT* and M-VNRRT* at ``tau`` (``planner.tau``),
+    and the ``machine`` whose timings these are (None: not recorded). ``networks``:
     ``predict.json``'s metrics per network."""
     out: dict = {"mass_x": {}, "opt_ms": {}, "interior_ap": {}}
     for net, m in networks.items():
