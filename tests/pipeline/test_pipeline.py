@@ -607,6 +607,8 @@ def test_a_tau_ablation_reruns_only_m_vnrrt_and_moves_no_other_verdict(workdir):
         and "claim |" not in line
     ]
     assert rows and all("| +0.0% |" in r and "identical: re-timing only" in r for r in rows)
+    shown = run(["dvc", "exp", "show", "--only-changed", "--drop", ".*/.*"], workdir)  # README's
+    assert "planner.tau" in shown and max(map(len, shown.splitlines())) <= 300, shown
 
 
 ABLATION = {  # every reader-visible setting changed at once from the session's (one experiment)
