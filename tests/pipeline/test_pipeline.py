@@ -286,7 +286,8 @@ def test_the_evaluation_run_page_shows_the_verdict_table_and_fig5_in_a_browser(
     workdir, tracking_server
 ):
     """The evaluation run's page in headless Chromium: the verdict table (every claim and
-    its verdict) and Fig. 5 rendered (loaded, non-empty) in the description; the report's
+    its verdict) and Fig. 5 rendered (loaded, non-empty) in the description, the run's name
+    and overrides tag (the session's settings are an ablation of conf/'s); the report's
     HTML in the artifact viewer's frame. Needs Debian's chromium (``apt-get install
     chromium`` as root)."""
     from tests.browser import Browser, chromium, open_run_page
@@ -316,6 +317,15 @@ def test_the_evaluation_run_page_shows_the_verdict_table_and_fig5_in_a_browser(
             " && i.naturalWidth > 0).map(i => [i.src, i.naturalWidth, i.naturalHeight])"
         )
         assert shown and "improvement_optimal.png" in shown[0][0] and shown[0][1] > 300
+        # the session's settings differ from conf/'s: the page names the run after them and
+        # shows them as its overrides tag
+        name, said = top["evaluation"]["info"]["run_name"], review.tags(top["evaluation"])
+        assert "eps=0.05" in name and "planner.eps=0.05" in said["overrides"], (name, said)
+        body = page.wait_for(
+            f"document.body.innerText.includes({json.dumps(name)}) && "
+            f"document.body.innerText.includes('overrides') && document.body.innerText"
+        )
+        assert body, f"the run page does not show its name {name!r} and overrides tag"
         page.goto(f"{tracking_server.url}/#/experiments/{exp_id}/runs/{run_id}/artifacts/"
                   "paper_comparison.html")  # fmt: skip
         frame = page.wait_for(
