@@ -22,6 +22,8 @@ import shutil
 import sys
 from pathlib import Path
 
+from omegaconf import OmegaConf
+
 from vnrrt.config import ConfigError, compose, load_params, restrict, stage_params
 
 BUNDLE = {  # file -> what it holds
@@ -36,6 +38,11 @@ BUNDLE = {  # file -> what it holds
     "eval.gpu also the GPU-trained networks')",
 }
 LATER_SECTIONS = ("bench_maps",)  # sections a bundle may predate: no recomputed stage reads them
+# settings a bundle may predate, at the value its run had in effect (RRT* timed once; fixed
+# budgets)
+LATER_SETTINGS = {"eval.timing_noise": False, "planner.iterations_per_free_cell": None,
+                  "planner.seconds_per_free_cell": None}  # fmt: skip
+_ABSENT = object()
 MACHINE = "machine.json"  # optional: {"machine": the CPU whose timings the tables hold}
 
 
@@ -126,8 +133,9 @@ def recompute(bundle: Path, out: Path) -> list[Path]:
     # every input comes from the bundle but the paper's numbers and settings, read where this
     # repository keeps them: the paths of this code, not of the run that made the bundle
     cfg.paths = compose([f"scale={cfg.scale.name}"]).paths
-    if "timing_noise" not in cfg.eval:  # a bundle from before the setting: RRT* timed once
-        cfg.eval.timing_noise = False
+    for key, value in LATER_SETTINGS.items():  # settings newer than the bundle
+        if OmegaConf.select(cfg, key, default=_ABSENT) is _ABSENT:
+            OmegaConf.update(cfg, key, value)
     predict, trainings = read_json(bundle / "predict.json"), read_json(bundle / "train.json")
     es = evaluate_settings(_view(cfg, "evaluate"))
     tables = checked_tables(bundle, es, read_json(bundle / "instances.json")["optima"])
