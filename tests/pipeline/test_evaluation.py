@@ -25,7 +25,7 @@ from vnrrt.maps.config import DataConfig
 from vnrrt.pipeline.evaluation import run_instances, run_trials_part
 from vnrrt.pipeline.paper_comparison import run_evaluate, run_report
 from vnrrt.search import path_mask
-from vnrrt.studies.paper_comparison.report import VERDICT_KEYS
+from vnrrt.studies.paper_comparison.headline import VERDICT_KEYS
 
 NETS = (("vertexnet", "vertex"), ("nrrtnet", "path"))
 

@@ -36,7 +36,7 @@ from vnrrt.data.shards import shard_file
 from vnrrt.evaluation.noise import baseline_record
 from vnrrt.evaluation.table import SEEDED_COLUMNS, merge_parts
 from vnrrt.maps.config import DataConfig
-from vnrrt.studies.paper_comparison.report import VERDICT_KEYS
+from vnrrt.studies.paper_comparison.headline import VERDICT_KEYS
 
 SHARDS = Path("data/smoke/shards")
 # The session's pipeline runs at these values rather than conf/'s defaults, so that every test

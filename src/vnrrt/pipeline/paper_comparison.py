@@ -116,7 +116,8 @@ def report_text(s: dict, summary: dict, predict: dict, trainings: dict, optima: 
     run (``against``: :func:`against_default`)."""
     from vnrrt.evaluation.config import mask_taus
     from vnrrt.evaluation.protocol import configurations
-    from vnrrt.studies.paper_comparison.report import ReportInputs, build_report, metric_settings
+    from vnrrt.studies.paper_comparison.networks_report import metric_settings
+    from vnrrt.studies.paper_comparison.report import ReportInputs, build_report
     from vnrrt.studies.paper_tables import load_paper_tables
 
     ev, planner = s["eval"], s["planner"]
@@ -184,7 +185,7 @@ def run_report(cfg: DictConfig) -> Path:
     from vnrrt.data.instances import Instances
     from vnrrt.infra.io import read_json, write_json, write_text
     from vnrrt.infra.machine import describe
-    from vnrrt.studies.paper_comparison.report import headline
+    from vnrrt.studies.paper_comparison.headline import headline
     from vnrrt.tracking import store as tracking
 
     s = report_settings(cfg)

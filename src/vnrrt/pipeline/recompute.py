@@ -124,7 +124,7 @@ def recompute(bundle: Path, out: Path) -> list[Path]:
         report_text,
     )
     from vnrrt.pipeline.sampling_ideas import ideas_settings, ideas_summary, ideas_text
-    from vnrrt.studies.paper_comparison.report import headline
+    from vnrrt.studies.paper_comparison.headline import headline
 
     missing = [n for n in BUNDLE if not (bundle / n).is_file()]
     if missing:

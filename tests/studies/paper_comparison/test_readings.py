@@ -10,6 +10,7 @@ import pandas as pd
 import pytest
 
 from vnrrt.evaluation.stats import compare
+from vnrrt.studies.paper_comparison.headline import headline
 from vnrrt.studies.paper_comparison.paper_noise import ratio_interval
 from vnrrt.studies.paper_comparison.readings import (
     COMPATIBLE,
@@ -21,7 +22,6 @@ from vnrrt.studies.paper_comparison.readings import (
     reading_verdict,
     robustness,
 )
-from vnrrt.studies.paper_comparison.report import headline
 
 LEVEL = 0.99
 

@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from vnrrt.evaluation.keys import ConfigKey, is_informed, label, sort_texts
+from vnrrt.evaluation.keys import is_informed, label, sort_texts
 from vnrrt.names import MAP_SET_NAMES as COLUMN_NAMES
 from vnrrt.names import level_name, percent, stop_title
 from vnrrt.studies.paper_comparison.claims import CONTRADICTS, verdict_text
@@ -29,77 +29,14 @@ from vnrrt.studies.paper_comparison.disclosure import (
     networks_scale_table,
     settings_table,
 )
+from vnrrt.studies.paper_comparison.headline import VERDICT_GROUPS
+from vnrrt.studies.paper_comparison.networks_report import (
+    MetricSettings,
+    inference_table,
+    networks_section,
+)
+from vnrrt.studies.paper_comparison.networks_report import num as _num
 from vnrrt.studies.paper_comparison.timing import timing_section
-
-
-@dataclass(frozen=True)
-class MetricSettings:
-    """How the networks' heatmap metrics were computed (``predict``): "near" within
-    ``radius`` px, recall at probability ``tau``, AP against targets dilated by
-    ``ap_radius`` px with start/goal disks of ``endpoint_radius`` px left out."""
-
-    radius: float
-    tau: float
-    ap_radius: float
-    endpoint_radius: float
-
-
-def metric_settings(settings: dict) -> MetricSettings:
-    """The :class:`MetricSettings` that ``predict.json`` records (its ``settings``)."""
-    keys = ("radius", "tau", "ap_radius", "endpoint_radius")
-    return MetricSettings(*(float(settings[k]) for k in keys))
-
-
-VERDICT_GROUPS = ("reproduced", "same direction", "no clear effect", "reversed")
-TARGET_MASKS = {"vertex": "interior", "path": "path"}  # what each network target is for
-
-
-HEADLINE_PLANNERS = {"rrt_star": "rrt", "nrrt_star": "nrrt", "vnrrt_star": "vnrrt",
-                     "m_vnrrt_star": "m"}  # fmt: skip
-
-
-def headline(summary: dict, networks: dict, tau: float, machine: str | None = None) -> dict:
-    """The few numbers of ``dvc metrics show`` (one line each under ~300 characters in a
-    terminal; the full tables are in the report and MLflow): the counts of verdicts
-    (:data:`VERDICT_KEYS`) on the paper's testable claims (an untestable claim gets no
-    verdict in the counts), each network's mass near what it is for (a vertex network: the
-    interior vertices; a path network: the path) as a multiple of a uniform map's, the
-    vertex networks' interior-vertex AP, the median planning time (ms) to the A*-relative
-    optimum on random maps of RRT*, NRRT*, VNRRT* and M-VNRRT* at ``tau`` (``planner.tau``),
-    and the ``machine`` whose timings these are (None: not recorded). ``networks``:
-    ``predict.json``'s metrics per network."""
-    out: dict = {"mass_x": {}, "opt_ms": {}, "interior_ap": {}}
-    for net, m in networks.items():
-        target = TARGET_MASKS[m["target"]]
-        share, uniform = (
-            m.get(f"test/mass_near_{target}"),
-            m.get(f"test/mass_near_{target}_uniform"),
-        )
-        if share is not None and uniform:
-            out["mass_x"][net] = round(share / uniform, 3)
-        if "test/interior_ap" in m and m["target"] == "vertex":
-            out["interior_ap"][net] = round(m["test/interior_ap"], 4)
-    for text, sets in summary["cells"].get("optimal", {}).items():
-        s, key = sets.get("random", {}).get("time_to_stop"), ConfigKey.parse(text)
-        protocol = ConfigKey(key.planner, tau if key.planner == "m_vnrrt_star" else None)
-        if s is not None and key == protocol:
-            out["opt_ms"][HEADLINE_PLANNERS[key.planner]] = round(1e3 * s["median"], 3)
-    rows = [r for r in summary["claims"]["rows"] if r["time_to_stop"]]
-    testable = [r for r in rows if r["testability"]["testable"]]
-    verdicts = [r["verdict"] for r in testable]  # one per testable claim; untestable: none
-    for group in VERDICT_GROUPS:
-        out[VERDICT_KEYS[group]] = sum(v.startswith(group) for v in verdicts)
-    out["testable"], out["untestable"] = len(testable), len(rows) - len(testable)
-    out["contradicting"] = sum(r["paper_data"] == CONTRADICTS for r in testable)
-    return out | ({"machine": machine} if machine else {})
-
-
-VERDICT_KEYS = {"reproduced": "reproduced", "same direction": "same_dir",
-                "no clear effect": "no_effect", "reversed": "reversed"}  # fmt: skip
-
-
-def _num(v: float, digits: int = 3) -> str:
-    return "n/a" if v is None or not math.isfinite(v) else f"{v:.{digits}g}"
 
 
 def cell(s: dict | None, scale: float = 1.0) -> str:
@@ -272,30 +209,6 @@ def speedup_table(speedups: dict, stop: str, columns: list[str]) -> str:
     return "\n".join(lines)
 
 
-def inference_table(summary: dict, inference_ms: dict[str, float], sources: dict[str, str]) -> str:
-    """Median planning time on random maps beside network inference per map."""
-    lines = [
-        "| configuration | stop rule | planning, median (ms) | inference per map (ms, CPU) "
-        "| planning + inference (ms) |",
-        "| --- | --- | --- | --- | --- |",
-    ]
-    for stop in ("initial", "optimal"):
-        for key, sets in summary["cells"].get(stop, {}).items():
-            if is_informed(key):
-                continue
-            s = sets.get("random", {}).get("time_to_stop")
-            if s is None:
-                continue
-            net = sources.get(key)
-            inf = inference_ms.get(net, 0.0) if net else 0.0
-            plan_ms = 1e3 * s["median"]
-            lines.append(
-                f"| {label(key)} | {stop} | {_num(plan_ms)} | "
-                f"{_num(inf) if net else '0 (no network)'} | {_num(plan_ms + inf)} |"
-            )
-    return "\n".join(lines)
-
-
 def rules(level: float, bootstrap: int) -> str:
     """How to read the tables (CIs at ``level`` from ``bootstrap`` resamples)."""
     return RULES.format(level=level_name(level), bootstrap=f"{bootstrap:,}")
@@ -361,56 +274,6 @@ def _speed(c: dict | None) -> str:
     if not c:
         return "—"
     return f"{c['speedup']:.2f}x [{c['ci_low']:.2f}, {c['ci_high']:.2f}]"
-
-
-NETWORK_COLUMNS = [  # (header, metric, its uniform baseline or None)
-    ("interior recall", "interior_recall", None),
-    ("interior AP", "interior_ap", None),
-    ("path AP", "path_ap", None),
-    ("mass near interior (x uniform)", "mass_near_interior", "mass_near_interior_uniform"),
-    ("mass near path (x uniform)", "mass_near_path", "mass_near_path_uniform"),
-    ("mass on start/goal", "mass_on_endpoints", None),
-]
-
-
-def networks_table(networks: dict[str, dict]) -> str:
-    """The heatmap metrics of each network (``predict.json``: ``<set>/<metric>``) on the
-    test and named maps, as shares with multiples of a uniform map's where it has one."""
-    taus = sorted({k.rsplit("_tau", 1)[1] for m in networks.values() for k in m
-                   if "mass_near_interior_tau" in k})  # fmt: skip
-    cols = [*NETWORK_COLUMNS, *((f"interior, tau {t.replace('_', '.')} mask (x uniform)",
-            f"mass_near_interior_tau{t}", "mass_near_interior_uniform") for t in taus)]  # fmt: skip
-    lines = ["| network | maps | " + " | ".join(c[0] for c in cols) + " |",
-             "|" + "---|" * (len(cols) + 2)]  # fmt: skip
-    for net, m in networks.items():
-        for group in ("test", "named"):
-            vals = []
-            for _, key, base in cols:
-                v, u = m.get(f"{group}/{key}"), m.get(f"{group}/{base}") if base else None
-                vals.append("—" if v is None else _num(v) + (f" ({v / u:.1f}x)" if u else ""))
-            lines.append(f"| {net} | {group} | " + " | ".join(vals) + " |")
-    return "\n".join(lines)
-
-
-def networks_section(networks: dict[str, dict], ms: MetricSettings) -> list[str]:
-    """The report's section on what the networks learnt (empty without metrics), with the
-    settings ``ms`` the metrics were computed with."""
-    if not networks:
-        return []
-    return [
-        "## The networks' heatmaps",
-        "",
-        networks_table(networks),
-        "",
-        "Interior: the A* label's vertices other than start and goal (what a vertex sampler "
-        f"should find; the start and goal are drawn in the input). Recall at probability "
-        f"{ms.tau:g} within {ms.radius:g} px; AP over pixels against the interior vertices "
-        f"(path cells), each dilated by {ms.ap_radius:g} px, the start/goal disks (radius "
-        f"{ms.endpoint_radius:g} px) left out of the interior AP; 'mass near': the share of "
-        f"the heatmap within {ms.radius:g} px, beside a uniform map's; the tau columns after "
-        "M-VNRRT*'s mask (an image left empty counts as uniform).",
-        "",
-    ]
 
 
 def shorter_range(optima: dict) -> str:
