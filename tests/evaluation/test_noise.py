@@ -89,7 +89,7 @@ def test_band_and_within():
 
 
 def _claim(text, speedup, iterations, verdict, column="random"):
-    return {"text": text, "table": "optimal_time", "column": column, "verdict": verdict,
+    return {"text": text, "stop": "optimal", "column": column, "verdict": verdict,
             "time_to_stop": {"speedup": speedup},
             "iterations": {"speedup": iterations}}  # fmt: skip
 
@@ -100,8 +100,7 @@ def test_a_verdict_that_moved_by_less_than_the_noise_is_flagged():
     now = [_claim("a", 1.25, 1.5, "no clear effect"), _claim("b", 2.0, 1.9, "larger"),
            _claim("c", 2.1, 2.2, "reproduced", "map_9"), _claim("new", 1.0, 1.0, "x")]  # fmt: skip
     noise = {"optimal": {"random": {"band_low": 0.9, "band_high": 1 / 0.9}}}
-    got = {c["text"]: c for c in changes(now, {"optimal_time": "optimal"},
-                                         baseline_record(before), noise)}  # fmt: skip
+    got = {c["text"]: c for c in changes(now, baseline_record(before), noise)}
     assert set(got) == {"a", "b", "c"}  # a claim the baseline lacks is left out
     a, b, c = got["a"], got["b"], got["c"]
     assert a["within_noise"] and a["iterations_same"] and a["ratio"] == pytest.approx(1.25 / 1.3)

@@ -53,19 +53,19 @@ def within(ratio: float, reading: dict | None) -> bool | None:
     return reading["band_low"] <= ratio <= reading["band_high"]
 
 
-def changes(rows: list[dict], stops: dict[str, str], baseline: dict, noise: dict) -> list[dict]:
-    """Each claim of ``rows`` (the summary's claim rows) against its reading in ``baseline``
-    (:func:`baseline_record`): ``{text, before, now, ratio, within_noise, iterations_same,
-    verdict_before, verdict_now}``; ``stops[table]`` is a claim table's stop rule and
-    ``noise`` :func:`timing_noise`'s result. Claims without data on either side are left
-    out."""
+def changes(rows: list[dict], baseline: dict, noise: dict) -> list[dict]:
+    """Each claim of ``rows`` (the summary's claim rows: ``stop`` and ``column`` name its
+    stop rule and map set) against its reading in ``baseline`` (:func:`baseline_record`):
+    ``{text, before, now, ratio, within_noise, iterations_same, verdict_before,
+    verdict_now}``; ``noise`` is :func:`timing_noise`'s result. Claims without data on
+    either side are left out."""
     out = []
     for row in rows:
         was, t = baseline.get(row["text"]), row["time_to_stop"]
         if was is None or t is None:
             continue
         ratio = t["speedup"] / was["speedup"]
-        reading = noise.get(stops[row["table"]], {}).get(row["column"])
+        reading = noise.get(row["stop"], {}).get(row["column"])
         it = row["iterations"]
         out.append({
             "text": row["text"],

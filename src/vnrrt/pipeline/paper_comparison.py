@@ -153,16 +153,8 @@ def against_default(paths: Paths, summary: dict, params: str = "params.yaml"):
         return None, ""
     if not Path(paths.baseline).is_file():
         return None, ""
-    stops = {name: spec["stop"] for name, spec in load_tables(paths)["tables"].items()}
     noise = summary.get("timing_noise", {})
-    return changes(rows, stops, read_json(paths.baseline), noise), override_text(changed)
-
-
-def load_tables(paths: Paths) -> dict:
-    """The paper's tables (``paths.paper_tables``)."""
-    from vnrrt.studies.paper_tables import load_paper_tables
-
-    return load_paper_tables(paths.paper_tables)
+    return changes(rows, read_json(paths.baseline), noise), override_text(changed)
 
 
 def gpu_trainings(paths: Paths) -> dict[str, dict]:

@@ -135,6 +135,11 @@ class PlannerConfig:
             raise PlannerConfigError(f"conf/planner/{option}.yaml: unknown setting(s) {unknown}")
         return cls().replace(**values)
 
+    @property
+    def scales_budgets(self) -> bool:
+        """Whether a budget grows with the map's free cells (:meth:`budgets`)."""
+        return self.iterations_per_free_cell is not None or self.seconds_per_free_cell is not None
+
     def budgets(self, free_cells: int) -> tuple[int, float]:
         """``(max_iterations, max_seconds)`` of a run on a map of ``free_cells`` free cells:
         the fixed budgets, or with the budget rule ``max(max_iterations,

@@ -107,9 +107,8 @@ class Setup:
     def budget(self) -> tuple[int, float]:
         """``(max_iterations, max_seconds)`` on this map (free cells counted only when the
         config scales a budget with them)."""
-        cfg = self.cfg
-        scaled = cfg.iterations_per_free_cell is not None or cfg.seconds_per_free_cell is not None
-        return cfg.budgets(self.occ.size - np.count_nonzero(self.occ) if scaled else 0)
+        free = self.occ.size - np.count_nonzero(self.occ) if self.cfg.scales_budgets else 0
+        return self.cfg.budgets(free)
 
     @functools.cached_property
     def bucket(self) -> float:

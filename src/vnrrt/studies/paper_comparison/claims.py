@@ -184,7 +184,7 @@ def claims(table: pd.DataFrame, paper: dict, st, shares: dict, strata: dict | No
     for claim, pair in zip(paper["claims"], pairs, strict=True):
         stop = paper["tables"][claim["table"]]["stop"]
         iv = claim_interval(paper, claim, strict).as_dict()
-        row = {**claim, "comparable": claim["column"] in comparable, "paper": iv}
+        row = {**claim, "stop": stop, "comparable": claim["column"] in comparable, "paper": iv}
         row |= _judged(_readings(pair, metrics, n_boot, strict), claim, iv, strict)
         t = row["readings"].get(PAPERS)
         row["paper_data"] = None if t is None else compatibility(t["difference"])
