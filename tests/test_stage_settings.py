@@ -83,6 +83,7 @@ CHANGED = {  # key -> a valid value other than the default's
     "regime.random_maps": 4,
     "regime.parts": [0, 1, 2],
     "budget.steps": [10, 20],  # multiples of the quick scale's trainer.max_epochs
+    "budget.seeds": [1, 2],
     "budget.report": ["training_budget"],
 }
 SECTIONS = ("eval", "stats", "oracle", "regime", "budget")
@@ -120,7 +121,8 @@ def _declares(stage: str, key: str) -> bool:
 
 def _view(cfg, stage: str):
     entry = _stages()[stage]
-    name = f"{stage}@0" if "foreach" in entry else stage
+    items = {"foreach": "0", "matrix": "-".join("0" * len(entry.get("matrix", {})))}
+    name = next((f"{stage}@{v}" for k, v in items.items() if k in entry), stage)
     return restrict(cfg, stage_params(name, REPO / "dvc.yaml"))
 
 

@@ -136,10 +136,11 @@ def test_a_stage_sees_only_what_it_declares(repo):
 
 
 def test_a_matrix_stage_names_each_axis_of_its_item(repo):
-    """``budget_train@<network>-<steps>``: ``${item.network}`` in its params is the network."""
-    keys = stage_params("budget_train@nrrtnet-600", repo / "dvc.yaml")
+    """``budget_train@<network>-<steps>-<seed>``: ``${item.network}`` in its params is the
+    network."""
+    keys = stage_params("budget_train@nrrtnet-600-1", repo / "dvc.yaml")
     assert "networks.nrrtnet" in keys and not [k for k in keys if "${" in k or "vertexnet" in k]
-    with pytest.raises(ConfigError, match="expected budget_train@<network>-<steps>"):
+    with pytest.raises(ConfigError, match="expected budget_train@<network>-<steps>-<seed>"):
         stage_params("budget_train@nrrtnet", repo / "dvc.yaml")
 
 

@@ -387,7 +387,8 @@ NOT_OUTPUTS = ("mlflow.db", "mlartifacts/")  # the MLflow store: runs, not pipel
 
 def _stage_of(argv: list[str]) -> tuple[str, str | None]:
     """``(stage, item)`` of a stage script's command line: ``stages/trials.py --part 1``,
-    ``stages/budget_train.py --network vertexnet --steps 3`` (item ``vertexnet-3``)."""
+    ``stages/budget_train.py --network vertexnet --steps 3 --seed 1`` (item
+    ``vertexnet-3-1``)."""
     name = Path(argv[0]).stem
     values = argv[2::2] if len(argv) > 2 and argv[1].startswith("--") else []
     return name, ("-".join(values) if values else None)
@@ -843,7 +844,7 @@ def test_the_budget_stages_reproduce_the_training_of_their_steps(workdir):
     assert ran == {"validate", *BUDGET_STAGES}, out
     assert stages_writing_their_outputs(workdir) >= BUDGET_STAGES
 
-    metrics, budget = workdir / "reports/metrics", workdir / "data/smoke/budget/3"
+    metrics, budget = workdir / "reports/metrics", workdir / "data/smoke/budget/3-1"
     predict = json.loads((metrics / "predict.json").read_text())["networks"]
     again = json.loads((budget / "predict.json").read_text())["networks"]
     sha = {}
@@ -862,7 +863,7 @@ def test_the_budget_stages_reproduce_the_training_of_their_steps(workdir):
     exp = client.get_experiment_by_name("vnrrt-smoke").experiment_id
     runs = client.search_runs([exp], filter_string="tags.budget_steps = '3'")
     stages = sorted(r.data.tags["dvc_stage"] for r in runs)
-    assert stages == ["budget_train@nrrtnet-3", "budget_train@vertexnet-3"]
+    assert stages == ["budget_train@nrrtnet-3-1", "budget_train@vertexnet-3-1"]  # train.seed 1
     for r in runs:
         assert r.data.params["budget.steps"] == "3" and r.info.run_name.endswith(" budget 3")
         assert r.data.tags["checkpoint_sha256"] == sha[r.data.tags["kind"]]

@@ -3,7 +3,8 @@ one-cycle schedule, run to its end; that the budget of a training's own steps is
 training: the slow DVC test in tests/pipeline/test_pipeline.py), its heatmap metrics are those of
 stage ``predict_metrics`` on the same checkpoint (and a uniform map's are what a uniform map
 gives), and a smoke-sized curve (64x64 maps, budgets of 2 and 4 steps) renders its table,
-trends and figures from paired trials."""
+trends and figures from paired trials, at two training seeds (pooled, and the claims read
+over the seeds)."""
 
 import json
 import math
@@ -23,11 +24,11 @@ from vnrrt.data.targets import label_masks
 from vnrrt.evaluation.instances import build_instances
 from vnrrt.evaluation.table import SEEDED_COLUMNS, read_table
 from vnrrt.model.checkpoint import read_checkpoint
+from vnrrt.pipeline.budget_training import run_budget_train
 from vnrrt.pipeline.predict import run_predict_metrics, run_predict_part
 from vnrrt.pipeline.training_budget import (
     run_budget_predict,
     run_budget_report,
-    run_budget_train,
     run_budget_trials,
 )
 from vnrrt.pipeline.validate import validate_config
@@ -38,6 +39,7 @@ N_RANDOM = 6
 ABLATION = ["planner.eps=0.05", "stats.level=0.9", "planner.tau=0.6", "planner.taus=[0.3,0.7]"]
 DEFAULTS = ("within 1%", "1% of", "95%", "eps 0.01", "τ=0.5", "τ=0.99", "tau0_5")
 BUDGETS = [2, 4]
+SEEDS = [0, 1]
 NETWORKS = ("vertexnet", "nrrtnet")
 # 2 epochs of 2 batches for the pipeline's training (4 steps: the budget of 4); a one-cycle
 # schedule needs pct_start x steps != 1; one thread, so that equal settings give equal bytes.
@@ -50,6 +52,7 @@ CURVE = [
     "predict.parts=[0]",
     "workers=1",
     "budget.steps=[2,4]",
+    "budget.seeds=[0,1]",
     "budget.report=[training_budget]",
     "stats.bootstrap=200",
     *ABLATION,
@@ -126,26 +129,28 @@ def _view(cfg, stage: str):
 def curve(small_data, tmp_path_factory):
     """The curve end to end on the 64x64 data through the stages' entry points, each seeing
     its declared parameters only: budgets of 2 and 4 steps over 2 epochs (1 and 2 batches
-    each), both networks, their heatmaps, the trials and the report; then budget 4's networks
-    through the pipeline's predict@0 and predict_metrics. Returns the config and the
-    summary."""
+    each) at training seeds 0 and 1, both networks, their heatmaps, the trials and the report;
+    then budget 4's seed-0 networks through the pipeline's predict@0 and predict_metrics.
+    Returns the config and the summary."""
     out = tmp_path_factory.mktemp("curve")
     cfg = small_cfg(small_data, out, *CURVE)
     _instances(cfg, small_data)
     before = torch.get_num_threads()
     try:
         for steps in BUDGETS:
-            for name in NETWORKS:
-                run_budget_train(_view(cfg, f"budget_train@{name}-{steps}"), name, steps)
-            run_budget_predict(_view(cfg, f"budget_predict@{steps}"), steps)
-            run_budget_trials(_view(cfg, f"budget_trials@{steps}"), steps)
+            for seed in SEEDS:
+                run = f"{steps}-{seed}"
+                for name in NETWORKS:
+                    run_budget_train(_view(cfg, f"budget_train@{name}-{run}"), name, steps, seed)
+                run_budget_predict(_view(cfg, f"budget_predict@{run}"), steps, seed)
+                run_budget_trials(_view(cfg, f"budget_trials@{run}"), steps, seed)
     finally:
         torch.set_num_threads(before)
     summary = run_budget_report(_view(cfg, "budget_report@training_budget"), "training_budget")
     models = Path(cfg.paths.models)  # budget 4's networks as the pipeline's, for predict_metrics
     for name in NETWORKS:
         for suffix in (".ckpt", ".ckpt.sha256"):
-            shutil.copy(models / f"budget/4/{name}{suffix}", models / f"{name}{suffix}")
+            shutil.copy(models / f"budget/4-0/{name}{suffix}", models / f"{name}{suffix}")
     try:
         run_predict_part(_view(cfg, "predict@0"), 0)
     finally:
@@ -161,9 +166,9 @@ def test_a_budget_of_n_steps_is_a_whole_training_of_n_steps(curve):
     tests/pipeline/test_pipeline.py (slow)."""
     cfg, summary = curve
     models = Path(cfg.paths.models)
-    for b in summary["budgets"]:
+    for b, seed in ((b, seed) for b in summary["budgets"] for seed in SEEDS):
         steps = b["steps"]
-        run = b["networks"]["vertexnet"]["train"]["budget"]
+        run = b["networks"]["vertexnet"]["train"][str(seed)]["budget"]
         assert run == {
             "steps": steps,
             "epochs": 2,
@@ -171,7 +176,7 @@ def test_a_budget_of_n_steps_is_a_whole_training_of_n_steps(curve):
             "schedule_steps": steps,
             "schedule_total": steps,
         }
-        ckpt = read_checkpoint(models / f"budget/{steps}/vertexnet.ckpt")
+        ckpt = read_checkpoint(models / f"budget/{steps}-{seed}/vertexnet.ckpt")
         sched = ckpt["lr_schedulers"][0]
         assert ckpt["global_step"] == steps and sched["total_steps"] == sched["last_epoch"] == steps
         saved = ckpt["optimizer_states"][0]["param_groups"][0]
@@ -179,14 +184,23 @@ def test_a_budget_of_n_steps_is_a_whole_training_of_n_steps(curve):
         last = _reference_lr(cfg, steps, steps - 1)  # the rate of the last optimizer step
         assert last == pytest.approx(saved["min_lr"]) and last < _reference_lr(cfg, 8, steps - 1)
         assert b["images"] == steps * cfg.train.datamodule.batch_size
-        assert not (models / f"budget/{steps}/checkpoints/vertexnet").exists()  # cleaned up
+        assert not (models / f"budget/{steps}-{seed}/checkpoints/vertexnet").exists()  # cleaned
+
+
+def test_each_training_seed_trains_other_weights(curve):
+    """Seeds 0 and 1 of one budget: the same settings but the seed, other weights."""
+    cfg, _ = curve
+    models = Path(cfg.paths.models)
+    for name in NETWORKS:
+        sums = {(models / f"budget/4-{s}/{name}.ckpt.sha256").read_text() for s in SEEDS}
+        assert len(sums) == 2, name
 
 
 def test_a_budget_stage_measures_its_heatmaps_as_predict_metrics_does(curve):
-    """Budget 4's networks through budget_predict@4, and through predict@0 and
+    """Budget 4's seed-0 networks through budget_predict@4-0, and through predict@0 and
     predict_metrics: the same metrics, settings and targets (all but the inference time)."""
     cfg, _ = curve
-    got = json.loads((Path(cfg.paths.budget) / "4/predict.json").read_text())
+    got = json.loads((Path(cfg.paths.budget) / "4-0/predict.json").read_text())
     want = json.loads(Path(cfg.paths.predict_metrics).read_text())
     assert got["settings"] == want["settings"] and set(got["networks"]) == set(NETWORKS)
     for name in NETWORKS:
@@ -202,7 +216,7 @@ def test_a_uniform_map_measures_as_a_uniform_map(curve):
     interior-vertex pixels among the pixels counted (an AP's chance level). That the networks'
     metrics are predict_metrics': the test above."""
     cfg, _ = curve
-    got = json.loads((Path(cfg.paths.budget) / "4/predict.json").read_text())
+    got = json.loads((Path(cfg.paths.budget) / "4-0/predict.json").read_text())
     uniform, network = got["uniform"], got["networks"]["vertexnet"]
     for key in ("mass_near_interior", "mass_near_path", "mass_near_vertex"):
         assert uniform[f"test/{key}"] == pytest.approx(network[f"test/{key}_uniform"], rel=1e-5)
@@ -211,8 +225,11 @@ def test_a_uniform_map_measures_as_a_uniform_map(curve):
 
 
 def test_the_budgets_share_instances_and_seeds(curve):
+    """Every budget and training seed runs the same trials of RRT* (the same rows); each
+    network's rows carry its training seed (``network_seed``), RRT*'s -1."""
     cfg, _ = curve
-    tables = [read_table(f"{cfg.paths.budget}/{s}/trials.csv") for s in BUDGETS]
+    runs = [(steps, seed) for steps in BUDGETS for seed in SEEDS]
+    tables = [read_table(f"{cfg.paths.budget}/{a}-{b}/trials.csv") for a, b in runs]
     assert set(tables[0]["map_set"]) == {"random"} and set(tables[0]["stop"]) == {
         "initial",
         "optimal",
@@ -223,34 +240,77 @@ def test_the_budgets_share_instances_and_seeds(curve):
     )
     cols = [c for c in SEEDED_COLUMNS if not c.startswith(("heat_", "mass_"))]
     rrt = [t[t["key"] == "rrt_star"][cols].reset_index(drop=True) for t in tables]
-    pd.testing.assert_frame_equal(rrt[0], rrt[1])  # uniform sampling: the same trials
+    for other in rrt[1:]:
+        pd.testing.assert_frame_equal(rrt[0], other)  # uniform sampling: the same trials
+    for (_, seed), t in zip(runs, tables, strict=True):
+        want = np.where(t["source"] == "", -1, seed)
+        np.testing.assert_array_equal(t["network_seed"].to_numpy(), want)
+
+
+def _trend(summary: dict, stop: str, metric: str) -> dict:
+    (t,) = [t for t in summary["trends"]
+            if (t["base"], t["planner"], t["stop"], t["metric"])
+            == ("rrt_star", "vnrrt_star", stop, metric)]  # fmt: skip
+    return t
 
 
 def test_the_ratio_to_nrrt_is_the_ratio_of_the_speedups_and_the_trend_its_slope(curve):
     """With one trial per instance the paired VNRRT*/NRRT* ratio is exactly the quotient of
-    the two speed-ups over RRT*; with two budgets the factor per doubling is the quotient
-    of the budgets' speed-ups raised to 1 / log2(images ratio)."""
+    the two speed-ups over RRT*, per seed and pooled over the seeds (the same instances: the
+    pooled log ratio is the mean of the seeds'); with two budgets each seed's factor per
+    doubling is the quotient of its budgets' speed-ups raised to 1 / log2(images ratio), and
+    the factor shown is their geometric mean."""
     _, summary = curve
     b0, b1 = summary["budgets"]
     images = b1["images"] / b0["images"]
     for stop in summary["settings"]["stops"]:
         for metric in summary["metrics"]:
-            for b in (b0, b1):
+            for b in (b0, b1, *b0["per_seed"], *b1["per_seed"]):
                 s, r = b["speedups"][stop][metric], b["ratios"][stop][metric]
                 want = s["vnrrt_star"]["speedup"] / s["nrrt_star"]["speedup"]
                 assert r["vnrrt_star"]["speedup"] == pytest.approx(want, rel=1e-9)
-            (t,) = [
-                t
-                for t in summary["trends"]
-                if (t["base"], t["planner"], t["stop"], t["metric"])
-                == ("rrt_star", "vnrrt_star", stop, metric)
-            ]
-            quotient = (
-                b1["speedups"][stop][metric]["vnrrt_star"]["speedup"]
-                / b0["speedups"][stop][metric]["vnrrt_star"]["speedup"]
-            )
-            assert t["per_doubling"] == pytest.approx(quotient ** (1 / math.log2(images)))
-            assert t["ci_low"] <= t["per_doubling"] <= t["ci_high"]
+            for b in (b0, b1):
+                seeds = [
+                    p["speedups"][stop][metric]["vnrrt_star"]["speedup"] for p in b["per_seed"]
+                ]
+                pooled = b["speedups"][stop][metric]["vnrrt_star"]
+                assert pooled["speedup"] == pytest.approx(math.exp(np.mean(np.log(seeds))))
+                assert pooled["ci_low"] <= pooled["speedup"] <= pooled["ci_high"]
+            t, factors = _trend(summary, stop, metric), []
+            for k, seed in enumerate(SEEDS):
+                one_b0, one_b1 = (b["per_seed"][k]["speedups"][stop][metric] for b in (b0, b1))
+                quotient = one_b1["vnrrt_star"]["speedup"] / one_b0["vnrrt_star"]["speedup"]
+                one = t["per_seed"][str(seed)]
+                assert one["per_doubling"] == pytest.approx(quotient ** (1 / math.log2(images)))
+                assert one["ci_low"] <= one["per_doubling"] <= one["ci_high"]
+                factors.append(one["per_doubling"])
+            assert t["per_doubling"] == pytest.approx(math.exp(np.mean(np.log(factors))))
+            seen = {v["verdict"] for v in t["per_seed"].values()}
+            assert t["verdict"] == (seen.pop() if len(seen) == 1 else "differs between seeds")
+
+
+def test_the_claims_over_seeds_pool_each_seeds_own_reading(curve):
+    """At the largest budget every random-map claim the budget trials can read is read: the
+    pooled estimate is the geometric mean of the seeds' own (paired on the same instances),
+    each seed's own equals the paired comparison of that seed's trials alone, and the
+    interval is at the level corrected over the claims read."""
+    import yaml
+
+    cfg, summary = curve
+    c, paper = summary["claims"], yaml.safe_load((REPO / "data/paper/tables.yaml").read_text())
+    masked = f"m_vnrrt_star@{cfg.planner.tau:g}"  # 0.6 here: the paper's tau-0.5 claims unread
+    want = [k["text"] for k in paper["claims"] if k["column"] == "random"
+            and ("@" not in k["planner"] or k["planner"] == masked)]  # fmt: skip
+    assert c["seeds"] == SEEDS and [r["text"] for r in c["rows"]] == want and len(want) == 3
+    assert c["corrected_level"] == pytest.approx(1 - (1 - cfg.stats.level) / 3)
+    for row in c["rows"]:
+        for metric in ("time_to_stop", "iterations"):
+            pooled = row["pooled"][metric]
+            own = [row["per_seed"][str(s)][metric]["speedup"] for s in SEEDS]
+            assert pooled["speedup"] == pytest.approx(math.exp(np.mean(np.log(own))))
+            assert pooled["ci_low"] <= pooled["speedup"] <= pooled["ci_high"]
+            for s, v in zip(SEEDS, own, strict=True):
+                assert pooled["per_seed_point"][str(s)] == pytest.approx(v)
 
 
 def test_the_curve_renders_its_report_and_figures(curve):
@@ -262,6 +322,8 @@ def test_the_curve_renders_its_report_and_figures(curve):
     eps, level = f"within {100 * cfg.planner.eps:g}% of A*", f"{100 * cfg.stats.level:g}%"
     for piece in (
         "## What the curve says",
+        "## The random-map claims over training seeds",
+        "training seeds 0, 1",
         "## Training",
         "in multiples of a uniform map",
         "## Trends over the images seen",

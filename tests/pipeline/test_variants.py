@@ -79,7 +79,7 @@ def test_a_tiny_comparison_writes_the_trainings_figures_and_reads_them_back(smal
     found = json.loads(out.with_suffix(".json").read_text())
     assert list(found["results"]) == ["baseline", "endpoints none"]
     for name, slug in (("baseline", "baseline"), ("endpoints none", "endpoints_none")):
-        trained = json.loads((work / slug / "budget/2/train_vertexnet.json").read_text())
+        trained = json.loads((work / slug / "budget/2-0/train_vertexnet.json").read_text())
         assert found["results"][name][SELECT] == trained[SELECT] and trained["steps"] == 2
         target = trained["target"]["endpoints"]
         assert target == ("none" if name == "endpoints none" else "both")

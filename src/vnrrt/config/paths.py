@@ -104,30 +104,31 @@ class Paths:
         return TrainFiles(self.checkpoint(network), self.checksum(network),
                           self.train_metrics(network), self.run_folder(network))  # fmt: skip
 
-    def budget_training(self, network: str, steps: int) -> TrainFiles:
-        """The files of stage ``budget_train@<network>-<steps>``: the checkpoint under
-        ``budget_models/<steps>/``, the metrics in :meth:`budget_folder`."""
-        models = Path(self.budget_models) / str(int(steps))
+    def budget_training(self, network: str, steps: int, seed: int) -> TrainFiles:
+        """The files of stage ``budget_train@<network>-<steps>-<seed>``: the checkpoint under
+        ``budget_models/<steps>-<seed>/``, the metrics in :meth:`budget_folder`."""
+        models = Path(self.budget_models) / budget_run(steps, seed)
         return TrainFiles(models / f"{network}.ckpt", models / f"{network}.ckpt.sha256",
-                          self.budget_folder(steps) / f"train_{network}.json",
+                          self.budget_folder(steps, seed) / f"train_{network}.json",
                           models / "checkpoints" / network)  # fmt: skip
 
-    def budget_folder(self, steps: int) -> Path:
-        """What the stages of training budget ``steps`` write besides the checkpoints."""
-        return Path(self.budget) / str(int(steps))
+    def budget_folder(self, steps: int, seed: int) -> Path:
+        """What the stages of training budget ``steps`` at training seed ``seed`` write besides
+        the checkpoints."""
+        return Path(self.budget) / budget_run(steps, seed)
 
-    def budget_heatmaps(self, steps: int) -> Path:
+    def budget_heatmaps(self, steps: int, seed: int) -> Path:
         """The folder of the budget's heatmaps (``part_0.npz``, stage ``budget_predict``)."""
-        return self.budget_folder(steps) / "heatmaps"
+        return self.budget_folder(steps, seed) / "heatmaps"
 
-    def budget_predict_metrics(self, steps: int) -> Path:
+    def budget_predict_metrics(self, steps: int, seed: int) -> Path:
         """The budget's heatmap metrics, as ``predict_metrics`` writes them (and a uniform
         map's)."""
-        return self.budget_folder(steps) / "predict.json"
+        return self.budget_folder(steps, seed) / "predict.json"
 
-    def budget_trials(self, steps: int) -> Path:
-        """The budget's trial table (stage ``budget_trials@<steps>``)."""
-        return self.budget_folder(steps) / "trials.csv"
+    def budget_trials(self, steps: int, seed: int) -> Path:
+        """The budget's trial table (stage ``budget_trials@<steps>-<seed>``)."""
+        return self.budget_folder(steps, seed) / "trials.csv"
 
     def heatmaps_part(self, part: int) -> Path:
         """Heatmaps of prediction part ``part`` (stage ``predict@<part>``)."""
@@ -191,12 +192,12 @@ def stage_outputs(stage: str, paths: Paths, item=None) -> list[Path]:
         "manifest": lambda: [p.manifest, p.data_metrics],
         "instances": lambda: [p.instances],
         "train": lambda: p.training(item).outputs(),
-        "budget_train": lambda: p.budget_training(*_network_steps(item)).outputs(),
+        "budget_train": lambda: p.budget_training(*_network_run(item)).outputs(),
         "budget_predict": lambda: [
-            heatmaps_part_file(p.budget_heatmaps(int(item)), 0),
-            p.budget_predict_metrics(int(item)),
+            heatmaps_part_file(p.budget_heatmaps(*parse_run(item)), 0),
+            p.budget_predict_metrics(*parse_run(item)),
         ],
-        "budget_trials": lambda: [p.budget_trials(int(item))],
+        "budget_trials": lambda: [p.budget_trials(*parse_run(item))],
         "budget_report": lambda: [p.budget_summary, p.budget_report, p.budget_figures],
         "bench_maps": lambda: [p.bench_maps_trials, p.bench_maps_summary, p.bench_maps_report],
         "predict": lambda: [p.heatmaps_part(int(item)), p.timing_part(int(item))],
@@ -213,9 +214,24 @@ def stage_outputs(stage: str, paths: Paths, item=None) -> list[Path]:
     return [Path(f) for f in table[stage]()]
 
 
-def _network_steps(item: str) -> tuple[str, int]:
-    """``("vertexnet", 600)`` of a ``budget_train`` item ``vertexnet-600`` (DVC's matrix name)."""
-    network, _, steps = str(item).rpartition("-")
-    if not network or not steps.isdigit():
-        raise ConfigError(f"budget_train item {item!r} is not <network>-<steps>")
-    return network, int(steps)
+def budget_run(steps: int, seed: int) -> str:
+    """``600-1``: the name of a training budget's run (``steps`` optimizer steps at training
+    seed ``seed``), as DVC names its stages' matrix items and its folders."""
+    return f"{int(steps)}-{int(seed)}"
+
+
+def parse_run(item: str) -> tuple[int, int]:
+    """``(600, 1)`` of a budget run's name ``600-1`` (:func:`budget_run`)."""
+    steps, _, seed = str(item).partition("-")
+    if not (steps.isdigit() and seed.isdigit()):
+        raise ConfigError(f"budget item {item!r} is not <steps>-<seed>")
+    return int(steps), int(seed)
+
+
+def _network_run(item: str) -> tuple[str, int, int]:
+    """``("vertexnet", 600, 1)`` of a ``budget_train`` item ``vertexnet-600-1`` (DVC's
+    matrix name)."""
+    parts = str(item).rsplit("-", 2)
+    if len(parts) != 3 or not parts[0]:
+        raise ConfigError(f"budget_train item {item!r} is not <network>-<steps>-<seed>")
+    return (parts[0], *parse_run(f"{parts[1]}-{parts[2]}"))

@@ -70,6 +70,9 @@ class TrialRow:
     # same iterations; eval.timing_noise, protocol RRT* only; NaN where not repeated)
     time_to_first_repeat: float = math.nan
     time_to_stop_repeat: float = math.nan
+    # the training seed (train.seed) of the network whose heatmap the sampler draws from; -1:
+    # none (RRT*, oracles), a network trained elsewhere, or a table written before the column
+    network_seed: int = -1
 
     def record(self) -> dict:
         """The row as ``{column: value}`` (convergence times as ``t_<f>x`` columns)."""
@@ -107,8 +110,10 @@ def frame(rows: list[TrialRow]) -> pd.DataFrame:
 def conform(table: pd.DataFrame, where: str) -> pd.DataFrame:
     """``table`` with exactly :data:`COLUMNS` in order and their dtypes; :class:`TableError`
     naming ``where`` if a column is missing (the :data:`REPEAT_COLUMNS`, absent from tables
-    written before they existed, read as NaN: not repeated)."""
+    written before they existed, read as NaN: not repeated; ``network_seed`` as -1)."""
     table = table.assign(**{c: math.nan for c in REPEAT_COLUMNS if c not in table.columns})
+    seeds = table["network_seed"] if "network_seed" in table.columns else -1
+    table = table.assign(network_seed=pd.Series(seeds, index=table.index).fillna(-1))
     missing = [c for c in COLUMNS if c not in table.columns]
     if missing:
         raise TableError(f"trial table {where} lacks columns {missing} (re-run the trials)")
@@ -119,6 +124,13 @@ def conform(table: pd.DataFrame, where: str) -> pd.DataFrame:
         else:
             out[col] = out[col].astype(dtype)
     return out
+
+
+def with_network_seeds(table: pd.DataFrame, seeds: dict[str, int]) -> pd.DataFrame:
+    """``table`` with ``network_seed`` set from ``seeds`` (heatmap source -> the training
+    seed of the network that made it) and -1 for every other source."""
+    mapped = table["source"].map({str(k): int(v) for k, v in seeds.items()})
+    return table.assign(network_seed=mapped.fillna(-1).astype("int64"))
 
 
 def write_table(table: pd.DataFrame, path: str | Path) -> None:

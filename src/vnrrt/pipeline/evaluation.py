@@ -54,6 +54,7 @@ def trials_settings(cfg: DictConfig) -> dict:
     return sections(cfg, paths=Paths, eval=EvalConfig, planner=PlannerConfig) | {
         "oracle": {"radius": float(cfg.oracle.radius)},
         "predict": {"parts": check_parts(cfg.predict.parts, "predict.parts")},
+        "train": {"seed": int(cfg.train.seed)},  # the networks' (the trials' network_seed)
         "seed": int(cfg.seed),
         "workers": int(cfg.workers),
     }
@@ -89,7 +90,7 @@ def run_trials_part(cfg: DictConfig, part: int) -> int:
         trial_counts,
         trial_jobs,
     )
-    from vnrrt.evaluation.table import write_table
+    from vnrrt.evaluation.table import with_network_seeds, write_table
     from vnrrt.evaluation.trials import HeatSettings, run_jobs
 
     s = trials_settings(cfg)
@@ -114,5 +115,6 @@ def run_trials_part(cfg: DictConfig, part: int) -> int:
     store = paths.reuse_store("trials")
     table = run_jobs(jobs, instances, s["seed"], s["workers"], planner, heat, store,
                      ev.timing_noise)  # fmt: skip
+    table = with_network_seeds(table, dict.fromkeys(trained, s["train"]["seed"]))
     write_table(table, paths.trials_part(part))
     return len(table)

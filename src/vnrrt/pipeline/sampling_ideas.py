@@ -124,6 +124,7 @@ def part_settings(cfg: DictConfig, which: str) -> dict:
     typed["regime"] = section(cfg, "regime", RegimeConfig) if which == "regime" else None
     if which == "regime":
         typed["predict"] = {"parts": check_parts(cfg.predict.parts, "predict.parts")}
+        typed["train"] = {"seed": int(cfg.train.seed)}  # the networks' (the trials' network_seed)
     return typed | {"seed": int(cfg.seed), "workers": int(cfg.workers)}
 
 
@@ -152,7 +153,7 @@ def _run(s: dict, jobs: list, configs: dict, out: Path, networks: list[str], sta
     """Run ``jobs`` (their instances read with the ``networks``' heatmaps) -> ``out``, reusing
     the kept rows of stage ``stage``'s unchanged configurations."""
     from vnrrt.data.instances import load
-    from vnrrt.evaluation.table import write_table
+    from vnrrt.evaluation.table import with_network_seeds, write_table
     from vnrrt.evaluation.trials import HeatSettings, run_jobs
 
     st = _study(s)
@@ -163,7 +164,8 @@ def _run(s: dict, jobs: list, configs: dict, out: Path, networks: list[str], sta
     heat = HeatSettings(oc.radius, ev.endpoint_radius, targets, None, oc.floor, ev.zero_obstacles)
     store = st.paths.reuse_store(stage)
     table = run_jobs(jobs, instances, s["seed"], s["workers"], configs, heat, store)
-    write_table(table, out)
+    seed = s.get("train", {}).get("seed", -1)
+    write_table(with_network_seeds(table, dict.fromkeys(networks, seed)), out)
     return len(table)
 
 

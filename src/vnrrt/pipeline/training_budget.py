@@ -1,12 +1,15 @@
 """Entry points of the budget curve's stages (:mod:`vnrrt.studies.training_budget`).
 
-* ``budget_train@<network>-<steps>``: one network trained for one budget
-  (:mod:`vnrrt.studies.training_budget.budget`) -> ``paths.budget_training(network, steps)``;
-* ``budget_predict@<steps>``: the heatmaps and heatmap metrics of one budget's networks, a
-  uniform map's metrics beside them -> ``paths.budget_heatmaps(steps)``,
-  ``paths.budget_predict_metrics(steps)``;
-* ``budget_trials@<steps>``: the trials of one training budget on its networks' heatmaps
-  (``paths.budget_heatmaps(steps)``) -> ``paths.budget_trials(steps)``;
+Each budget runs at every training seed of ``budget.seeds`` (the training variance):
+
+* ``budget_train@<network>-<steps>-<seed>``: one network trained for one budget at one seed
+  (:mod:`.budget_training`, a module of its own so that editing the others here leaves the
+  trainings' code deps unchanged) -> ``paths.budget_training(network, steps, seed)``;
+* ``budget_predict@<steps>-<seed>``: the heatmaps and heatmap metrics of one budget's
+  networks, a uniform map's metrics beside them -> ``paths.budget_heatmaps(steps, seed)``,
+  ``paths.budget_predict_metrics(steps, seed)``;
+* ``budget_trials@<steps>-<seed>``: the trials of one budget on its networks' heatmaps ->
+  ``paths.budget_trials(steps, seed)`` (column ``network_seed``: ``seed``);
 * ``budget_report@training_budget``: every budget's trials, heatmap metrics and training
   metrics (checked complete) -> the statistics (``paths.budget_summary``), the report
   (``paths.budget_report``) and its figures (``paths.budget_figures``).
@@ -25,27 +28,15 @@ from vnrrt.config.paths import Paths
 log = logging.getLogger(__name__)
 
 
-def run_budget_train(cfg: DictConfig, network: str, steps: int) -> dict:
-    """Stage ``budget_train@<network>-<steps>``: ``network`` trained for ``steps`` optimizer
-    steps with a schedule of its own (:func:`vnrrt.studies.training_budget.budget.budget_config`) ->
-    ``paths.budget_training(network, steps)``, resumable as the pipeline's trainings; its
-    metrics add ``budget`` (:func:`~vnrrt.studies.training_budget.budget.budget_record`)."""
-    from vnrrt.pipeline.training import train_network
-    from vnrrt.studies.training_budget.budget import budget_config
-
-    files = section(cfg, "paths", Paths).budget_training(network, steps)
-    return train_network(budget_config(cfg, steps), network, files, budget=int(steps))
-
-
 UNIFORM = 0.5  # the constant map whose metrics are "a uniform map's" (every pixel above tau 0.5)
 
 
-def run_budget_predict(cfg: DictConfig, steps: int) -> dict:
-    """Stage ``budget_predict@<steps>``: the heatmaps of every instance by the networks of
-    ``predict.networks`` trained for ``steps`` (``paths.budget_training``) ->
-    ``heatmaps/part_0.npz`` of ``paths.budget_heatmaps(steps)``, and their metrics as stage
-    ``predict_metrics`` computes them, beside those of a constant (uniform) map ``uniform``,
-    -> ``paths.budget_predict_metrics(steps)``; returns what it wrote."""
+def run_budget_predict(cfg: DictConfig, steps: int, seed: int) -> dict:
+    """Stage ``budget_predict@<steps>-<seed>``: the heatmaps of every instance by the
+    networks of ``predict.networks`` trained for ``steps`` at seed ``seed``
+    (``paths.budget_training``) -> ``heatmaps/part_0.npz`` of ``paths.budget_heatmaps``, and
+    their metrics as stage ``predict_metrics`` computes them, beside those of a constant
+    (uniform) map ``uniform``, -> ``paths.budget_predict_metrics``; returns what it wrote."""
     import dataclasses
 
     import numpy as np
@@ -60,10 +51,11 @@ def run_budget_predict(cfg: DictConfig, steps: int) -> dict:
     torch.set_num_threads(int(cfg.predict.threads))
     instances = Instances(paths.instances)
     rows = np.arange(len(instances))
-    nets = {n: paths.budget_training(n, steps).checkpoint for n in cfg.predict.networks}
+    nets = {n: paths.budget_training(n, steps, seed).checkpoint for n in cfg.predict.networks}
     maps, meta, timing = predict_rows(cfg, nets, instances, rows)
-    write_heatmaps(part_file(paths.budget_heatmaps(steps), 0), instances.keys, maps,
-                   networks=meta, part=0, parts=1, budget_steps=int(steps))  # fmt: skip
+    write_heatmaps(part_file(paths.budget_heatmaps(steps, seed), 0), instances.keys, maps,
+                   networks=meta, part=0, parts=1, budget_steps=int(steps),
+                   train_seed=int(seed))  # fmt: skip
     ms = metric_settings(cfg)
     targets = {n: m["target"]["kind"] for n, m in meta.items()}
     flat = np.full((len(instances), instances.size, instances.size), UNIFORM, np.float16)
@@ -72,7 +64,7 @@ def run_budget_predict(cfg: DictConfig, steps: int) -> dict:
         "networks": network_metrics(maps, instances, ms, targets, [timing]),
         "uniform": split_metrics(flat, instances, ms),
     }
-    write_json(paths.budget_predict_metrics(steps), out)
+    write_json(paths.budget_predict_metrics(steps, seed), out)
     return out
 
 
@@ -91,7 +83,7 @@ def _design(cfg: DictConfig) -> dict:
 
 
 def trials_settings(cfg: DictConfig) -> dict:
-    """What stage ``budget_trials@<steps>`` reads, typed (keyed by config section)."""
+    """What stage ``budget_trials@<steps>-<seed>`` reads, typed (keyed by config section)."""
     from vnrrt.planners.config import PlannerConfig
 
     return sections(cfg, paths=Paths, planner=PlannerConfig) | {
@@ -102,10 +94,10 @@ def trials_settings(cfg: DictConfig) -> dict:
     }
 
 
-def run_budget_trials(cfg: DictConfig, steps: int) -> int:
-    """Stage ``budget_trials@<steps>`` (module doc); returns the number of trials."""
+def run_budget_trials(cfg: DictConfig, steps: int, seed: int) -> int:
+    """Stage ``budget_trials@<steps>-<seed>`` (module doc); returns the number of trials."""
     from vnrrt.data.instances import Instances, load
-    from vnrrt.evaluation.table import write_table
+    from vnrrt.evaluation.table import with_network_seeds, write_table
     from vnrrt.evaluation.trials import HeatSettings, run_jobs
     from vnrrt.studies.training_budget.design import BudgetTrials
 
@@ -114,14 +106,16 @@ def run_budget_trials(cfg: DictConfig, steps: int) -> int:
     jobs = design.jobs(Instances(paths.instances).kinds, planner.tau)
     networks = sorted({j.key.source for j in jobs if j.key.source is not None})
     indices = sorted({j.instance for j in jobs})
-    heatmaps = paths.budget_heatmaps(steps)
+    heatmaps = paths.budget_heatmaps(steps, seed)
     instances, targets = load(paths.instances, indices, networks, heatmaps, [0])
-    log.info("budget %d: %d trial jobs on %d instances", steps, len(jobs), len(instances))
+    log.info("budget %d, seed %d: %d trial jobs on %d instances", steps, seed, len(jobs),
+             len(instances))  # fmt: skip
     heat = HeatSettings(s["oracle"]["radius"], design.endpoint_radius, targets,
                         zero_obstacles=design.zero_obstacles)  # fmt: skip
     store = paths.reuse_store("budget_trials")
     table = run_jobs(jobs, instances, s["seed"], s["workers"], planner, heat, store)
-    write_table(table, paths.budget_trials(steps))
+    table = with_network_seeds(table, dict.fromkeys(networks, int(seed)))
+    write_table(table, paths.budget_trials(steps, seed))
     return len(table)
 
 
@@ -140,9 +134,10 @@ def report_settings(cfg: DictConfig) -> dict:
 
 
 def budget_inputs(s: dict) -> list[dict]:
-    """Per budget (ascending): ``{"steps", "trials": table, "predict": its heatmap metrics,
-    "trainings": {network: training metrics}}``; :class:`~vnrrt.evaluation.table.TableError`
-    unless each trial table holds exactly its jobs' rows."""
+    """Per budget (ascending) and training seed (ascending): ``{"steps", "seed", "trials":
+    table, "predict": its heatmap metrics, "trainings": {network: training metrics}}``;
+    :class:`~vnrrt.evaluation.table.TableError` unless each trial table holds exactly its
+    jobs' rows."""
     from vnrrt.data.instances import Instances
     from vnrrt.evaluation.invariants import design_of
     from vnrrt.evaluation.table import TableError, read_table
@@ -156,27 +151,39 @@ def budget_inputs(s: dict) -> list[dict]:
     networks = sorted({k.source for k in design.keys(rules.tau) if k.source is not None})
     out = []
     for steps in s["budget"].steps:
-        table = read_table(paths.budget_trials(steps))
-        if len(table) != rows:
-            raise TableError(f"{paths.budget_trials(steps)} holds {len(table)} trials, not the "
-                             f"{rows} of this protocol (re-run `dvc repro`)")  # fmt: skip
-        expected.check(table, str(paths.budget_trials(steps)))
-        trainings = {n: read_json(paths.budget_training(n, steps).metrics) for n in networks}
-        predict = read_json(paths.budget_predict_metrics(steps))
-        out.append({"steps": steps, "trials": table, "predict": predict, "trainings": trainings})
+        for seed in s["budget"].seeds:
+            file = paths.budget_trials(steps, seed)
+            table = read_table(file)
+            if len(table) != rows:
+                raise TableError(f"{file} holds {len(table)} trials, not the {rows} of this "
+                                 "protocol (re-run `dvc repro`)")  # fmt: skip
+            expected.check(table, str(file))
+            trainings = {n: read_json(paths.budget_training(n, steps, seed).metrics)
+                         for n in networks}  # fmt: skip
+            predict = read_json(paths.budget_predict_metrics(steps, seed))
+            out.append({"steps": steps, "seed": seed, "trials": table, "predict": predict,
+                        "trainings": trainings})  # fmt: skip
     return out
 
 
 def run_budget_report(cfg: DictConfig, name: str) -> dict:
     """Stage ``budget_report@<name>`` (module doc); returns the summary."""
     from vnrrt.infra.io import read_json, write_json, write_text
-    from vnrrt.studies.training_budget.summary import analyze_budgets
+    from vnrrt.studies.paper_tables import load_paper_tables
+    from vnrrt.studies.training_budget.claims import seed_claims
+    from vnrrt.studies.training_budget.pooled import analyze_budgets
+    from vnrrt.studies.training_budget.summary import clean
 
     s = report_settings(cfg)
     if name not in s["budget"].report:
         raise ConfigError(f"report {name!r} is not in budget.report {s['budget'].report}")
-    paths = s["paths"]
-    write_json(paths.budget_summary, analyze_budgets(budget_inputs(s), summary_settings(s)))
+    paths, inputs, settings = s["paths"], budget_inputs(s), summary_settings(s)
+    summary = analyze_budgets(inputs, settings)
+    largest = [i for i in inputs if i["steps"] == inputs[-1]["steps"]]
+    paper = load_paper_tables(paths.paper_tables)
+    claims = seed_claims(largest, paper, s["stats"], settings["keys"], paper["tables"])
+    summary["claims"] = clean(claims)
+    write_json(paths.budget_summary, summary)
     summary = read_json(paths.budget_summary)  # what every reader sees: the file's numbers
     figures = save_figures(paths, summary)
     write_text(paths.budget_report, report_text(paths, summary, figures))
@@ -193,6 +200,7 @@ def summary_settings(s: dict) -> dict:
     return {
         "scale": s["scale"]["name"],
         "train_seed": s["train"]["seed"],
+        "seeds": list(s["budget"].seeds),
         "eps": rules.eps,
         "tau": rules.tau,
         "level": st.level,

@@ -105,7 +105,7 @@ def train_variant(base: list[str], variant: Variant, steps: int, work: Path) -> 
     from vnrrt.config import compose, section
     from vnrrt.config.paths import Paths
     from vnrrt.infra.io import read_json
-    from vnrrt.pipeline.training_budget import run_budget_train
+    from vnrrt.pipeline.budget_training import run_budget_train
 
     folder = work / variant.slug
     places = [
@@ -115,12 +115,13 @@ def train_variant(base: list[str], variant: Variant, steps: int, work: Path) -> 
         f"paths.figures={folder / 'figures'}",
     ]
     cfg = compose([*base, *variant.overrides(), *places, "logger.enabled=false"])
-    files = section(cfg, "paths", Paths).budget_training("vertexnet", steps)
+    seed = int(cfg.train.seed)
+    files = section(cfg, "paths", Paths).budget_training("vertexnet", steps, seed)
     if files.metrics.is_file() and files.checkpoint.is_file():
         log.info("%s: read back from %s", variant.name, files.metrics)
         return read_json(files.metrics)
     log.info("%s: training %d steps (%s)", variant.name, steps, variant.overrides())
-    return run_budget_train(cfg, "vertexnet", steps)
+    return run_budget_train(cfg, "vertexnet", steps, seed)
 
 
 def compare(base: list[str], steps: int, work: Path, only: list[str] | None = None) -> dict:

@@ -23,17 +23,22 @@ REPORT = "training_budget"  # the one name of stage budget_report@<name> (budget
 @dataclass
 @conf_defaults("budget")
 class BudgetConfig:
-    """The ``budget`` section: ``steps``, the budgets (optimizer steps, ascending), and
-    ``report``, ``[training_budget]`` where there are budgets and ``[]`` where there are
-    none (DVC makes no report stage of a foreach over ``[]``)."""
+    """The ``budget`` section: ``steps``, the budgets (optimizer steps, ascending);
+    ``seeds``, the training seeds (``train.seed``) at which both networks are trained for
+    every budget (ascending); and ``report``, ``[training_budget]`` where there are budgets
+    and ``[]`` where there are none (DVC makes no report stage of a matrix over ``[]``)."""
 
     steps: list[int]
+    seeds: list[int]
     report: list[str]
 
     def validate(self) -> None:
-        steps = self.steps
+        steps, seeds = self.steps, self.seeds
         ok = all(isinstance(s, int) and s >= 1 for s in steps) and steps == sorted(set(steps))
         check(ok, "budget.steps", steps, "distinct positive integers, ascending")
+        ok = all(isinstance(s, int) and s >= 0 for s in seeds) and seeds == sorted(set(seeds))
+        check(ok and bool(seeds), "budget.seeds", seeds,
+              "distinct non-negative integers, ascending, at least one")  # fmt: skip
         want = [REPORT] if steps else []
         check(self.report == want, "budget.report", self.report,
               f"must be {want} where budget.steps is {steps}")  # fmt: skip
@@ -49,11 +54,12 @@ def batches_per_epoch(steps: int, max_epochs: int) -> int:
     return steps // max_epochs
 
 
-def budget_config(cfg, steps: int):
+def budget_config(cfg, steps: int, seed: int):
     """A copy of a training stage's config ``cfg`` (a ``DictConfig``) training for ``steps``
-    optimizer steps (module doc)."""
+    optimizer steps (module doc) at training seed ``seed`` (``train.seed``)."""
     out = copy.deepcopy(cfg)
     out.trainer.limit_train_batches = batches_per_epoch(int(steps), int(cfg.trainer.max_epochs))
+    out.train.seed = int(seed)
     return out
 
 

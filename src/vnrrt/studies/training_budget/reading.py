@@ -16,6 +16,7 @@ TREND_WORDS = {
     "grows": "VNRRT* gains on NRRT* as the networks learn",
     "shrinks": "VNRRT* loses ground to NRRT* as the networks learn",
     "no clear trend": "no clear trend within the measured range",
+    "differs between seeds": "no trend holds across the training seeds (their labels differ)",
 }
 
 

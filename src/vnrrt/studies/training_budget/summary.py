@@ -1,5 +1,6 @@
-"""Statistics of the budget curve, computed once (stage ``budget_report``) as plain JSON-able
-data (``paths.budget_summary``) for the report and the figures.
+"""Statistics of one training seed's budget curve (the whole summary, over seeds:
+:mod:`.pooled`), as plain JSON-able data (``paths.budget_summary``) for the report and the
+figures.
 
 * **Per budget**: the networks' heatmap metrics over the random instances in multiples of a
   uniform map's (the same metric of a constant map: an AP's is the positives' share, a
@@ -146,22 +147,3 @@ def trends(inputs: list[dict], images: list[int], settings: dict) -> list[dict]:
     return [trend(tables, images, base, plan, stop, metric, settings)
             for stop in settings["stops"] for metric in METRICS
             for base, plan in pairs]  # fmt: skip
-
-
-def analyze_budgets(inputs: list[dict], settings: dict) -> dict:
-    """The whole summary of the budget curve (module doc) of at least one budget's inputs;
-    ``settings`` (kept in the summary for its readers, with the heatmap metrics' own) holds
-    at least ``stops``, ``keys``, ``ratio_keys``, ``bootstrap`` and ``level``."""
-    if not inputs:
-        raise ValueError("the budget curve needs at least one budget (budget.steps)")
-    points = [budget_point(inp, settings) for inp in inputs]
-    first = _random(inputs[0]["trials"])
-    summary = {
-        "settings": {**settings, "heatmap": dict(inputs[0]["predict"]["settings"])},
-        "metrics": list(METRICS),
-        "budgets": points,
-        "trends": trends(inputs, [p["images"] for p in points], settings),
-        "instances": int(first["instance"].nunique()),
-        "clusters": int(first["cluster"].nunique()),
-    }
-    return clean(summary)

@@ -1,0 +1,50 @@
+"""The report's section on the paper's random-map claims over the training seeds' networks
+(:mod:`.claims`), from the summary alone."""
+
+from __future__ import annotations
+
+from vnrrt.names import level_name
+
+
+def _pct(cell: dict) -> str:
+    """``-12.3% [-20.1%, -3.0%]`` of a reading (ratio - 1)."""
+    return (f"{cell['speedup'] - 1:+.1%} [{cell['ci_low'] - 1:+.1%}, "
+            f"{cell['ci_high'] - 1:+.1%}]")  # fmt: skip
+
+
+def _seed_cell(seed: str, cell: dict) -> str:
+    """One seed's time reading, its verdict and, if untestable, why."""
+    t = cell["time_to_stop"]
+    text = f"{seed}: {_pct(t)}, {t['verdict']}"
+    return text if cell["testability"]["testable"] else f"{text} (untestable)"
+
+
+def seed_claims_section(summary: dict) -> list[str]:
+    """The section (module doc); nothing where the summary has no claims."""
+    c = summary.get("claims")
+    if not c or not c["rows"]:
+        return []
+    seeds = ", ".join(str(s) for s in c["seeds"])
+    steps = summary["budgets"][-1]["steps"]
+    head = ["claim", "paper", "pooled over seeds: time [CI]", "verdict (pooled)",
+            "pooled: iterations [CI]", "each seed: time [CI], verdict",
+            "seeds whose sampler tests the claim"]  # fmt: skip
+    lines = ["## The random-map claims over training seeds", "",
+             f"The paper's quoted claims on random maps, read at the largest budget ({steps:,} "
+             f"steps, the pipeline's own training) over the networks of training seeds {seeds}: "
+             "pooled, the interval resamples the seeds, then base maps, instances and trials, so "
+             "it includes the training variance; beside it, each seed's network pair alone. "
+             "Planning time, our estimand (geometric mean over instances of median(baseline) / "
+             f"median(planner)), at {level_name(c['corrected_level'])} (Bonferroni over the "
+             f"{len(c['rows'])} claims read here; {c['bootstrap']:,} resamples); verdicts as in "
+             "the paper comparison, against the paper's value and its own interval. A masked "
+             f"claim is untestable with a network when its sampler has {c['untestable_rule']}.",
+             "", "| " + " | ".join(head) + " |", "|" + " --- |" * len(head)]  # fmt: skip
+    for row in c["rows"]:
+        pooled = row["pooled"]
+        per = "; ".join(_seed_cell(k, v) for k, v in row["per_seed"].items())
+        cells = [row["text"], f"{row['quoted']:+.2%}", _pct(pooled["time_to_stop"]),
+                 pooled["time_to_stop"]["verdict"], _pct(pooled["iterations"]), per,
+                 f"{row['testable_seeds']} of {len(row['per_seed'])}"]  # fmt: skip
+        lines.append("| " + " | ".join(cells) + " |")
+    return [*lines, ""]
