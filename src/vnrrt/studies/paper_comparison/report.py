@@ -331,6 +331,12 @@ def build_report(inp: ReportInputs) -> str:
         "",
         multiple_note(summary["claims"]),
         "",
+        "These claims read one trained network pair (the pipeline's `train.seed`): their "
+        "intervals hold no training variance. The random-map claims read over several "
+        "training seeds' network pairs, with intervals that include it, are in "
+        "[training_budget.md](training_budget.md) at the scales that train them "
+        "(`budget.seeds`).",
+        "",
         "### Each claim under both estimands",
         "",
         "The paper's estimand (ratio of means) and ours (geometric mean of per-instance ratios "
