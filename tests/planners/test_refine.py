@@ -21,7 +21,7 @@ from vnrrt.planners import (
 )
 from vnrrt.planners import tree as nodes
 from vnrrt.planners.collision import segment_free
-from vnrrt.planners.seeding import rng_state
+from vnrrt.planners.samplers import rng_state
 
 
 def wall() -> np.ndarray:

@@ -32,8 +32,7 @@ from vnrrt.planners.clock import monotonic
 from vnrrt.planners.config import PlannerConfig
 from vnrrt.planners.result import Milestone, PlanResult
 from vnrrt.planners.rrt_star import TREE_FULL, Params
-from vnrrt.planners.samplers import Draws, Sampler
-from vnrrt.planners.seeding import rng_state
+from vnrrt.planners.samplers import Draws, Sampler, rng_state
 
 FIRST_CAPACITY = 4096  # tree nodes allocated first; doubled when full (up to the budget)
 FIRST_CHUNK, MAX_CHUNK = 64, 4096  # iterations per chunk; budgets checked between
@@ -164,7 +163,7 @@ def gamma(occ: np.ndarray, cfg: PlannerConfig) -> float:
 
 def run(occ: np.ndarray, query: Query, *, planner: str, setup: Setup, seed) -> PlanResult:
     """The timed run of ``query`` (module doc) with ``setup``'s settings and arrays, sampling
-    from the xoshiro256** generator seeded by ``seed`` (:func:`.seeding.rng_state`)."""
+    from the xoshiro256** generator seeded by ``seed`` (:func:`.samplers.rng_state`)."""
     (sx, sy), (gx, gy) = query.start, query.goal
     target, d, spent, cfg = query.target, -1.0, 0.0, setup.cfg
     if cfg.straight_first:

@@ -13,7 +13,7 @@ and the gap sampler (a share of the samples from the narrow-passage cells of :mo
 If no positive weight is left, the sampler falls back to uniform (no heatmap draws) and sets
 ``fallback_uniform``. Huge or tiny weights are scaled by a power of two before they are summed
 (the draws stay those of the given weights). Randomness comes from a xoshiro256** generator
-seeded as :class:`numpy.random.SeedSequence` seeds it (:func:`.seeding.rng_state`).
+seeded by :class:`numpy.random.SeedSequence` (:func:`rng_state`).
 """
 
 from __future__ import annotations
@@ -27,7 +27,6 @@ import numpy as np
 from numba import njit
 
 from vnrrt.grid import GridError
-from vnrrt.planners.seeding import rng_state
 
 _INV_2_53 = 1.0 / 9007199254740992.0
 NO_CELLS = np.zeros(1, np.int64)  # the gap cells of a sampler without (or not yet with) any
@@ -48,6 +47,16 @@ class Draws(NamedTuple):
     gap_after: int = 0
     gap_cells: np.ndarray = NO_CELLS
     n_gaps: int = 0
+
+
+def rng_state(seed) -> np.ndarray:
+    """Fresh xoshiro256** state ``(4,)`` uint64 from ``seed`` (int >= 0 or tuple of them):
+    ``SeedSequence(seed).generate_state(4, np.uint64)``, the all-zero state (the one invalid
+    xoshiro state) made ``[1, 0, 0, 0]``."""
+    state = np.random.SeedSequence(seed).generate_state(4, dtype=np.uint64)
+    if not state.any():
+        state[0] = 1
+    return state
 
 
 @njit(cache=True, inline="always")
