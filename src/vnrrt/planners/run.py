@@ -190,8 +190,11 @@ def run(occ: np.ndarray, query: Query, *, planner: str, setup: Setup, seed) -> P
         tree.enlarge(max_iterations)
     elapsed = time.perf_counter() - t0
     reached = dict(zip(stops.tolist(), zip(times.tolist(), iters.tolist()), strict=True))
-    return result(tree, planner, query, reason=REASONS[code], reached=reached,
-                  elapsed=elapsed, arrays=arrays, budget=setup.budget)  # fmt: skip
+    c, t = tree.counters, tree.tree
+    counts = (int(c.iters[0]), int(c.nodes[0]), int(c.checks[0]))
+    return result(planner, query, setup.budget, reason=REASONS[code], reached=reached,
+                  elapsed=elapsed, counts=counts, arrays=arrays,
+                  tree=(t.pts, t.links[:, nodes.PARENT]))  # fmt: skip
 
 
 def stop_bounds(query: Query) -> np.ndarray:
@@ -251,36 +254,30 @@ def grow_tree(occ, tree, scratch, counters, trace, rng, draws, stops, p, first, 
         state[0] = min(2 * state[0], MAX_CHUNK)
 
 
-def result(
-    tree: Tree,
-    planner: str,
-    query: Query,
-    *,
-    reason: str,
-    reached: dict[float, tuple[float, int]],
-    elapsed: float,
-    arrays: list,
-    budget: tuple[int, float],
-) -> PlanResult:
-    """The :class:`PlanResult` of a finished run; ``reached[bound] = (seconds, iteration)``;
-    ``arrays``: its path, segment lengths, trace iterations and costs (:func:`grow_tree`);
-    ``budget``: its ``(max_iterations, max_seconds)``."""
-    c, t = tree.counters, tree.tree
-    n, g, k = int(c.nodes[0]), int(c.goal[0]), int(c.trace_len[0])
+def result(planner: str, query: Query, budget: tuple[int, float], *, reason: str,
+           reached: dict[float, tuple[float, int]], elapsed: float, counts: tuple[int, int, int],
+           arrays, tree) -> PlanResult:  # fmt: skip
+    """The :class:`PlanResult` of a finished run with ``budget`` ``(max_iterations,
+    max_seconds)``: ``reached[bound] = (seconds, iteration)`` for ``inf`` and each of
+    ``query.bounds``; ``counts`` its ``(iterations, tree nodes N, collision checks)``;
+    ``arrays`` its path, segment lengths, trace iterations and costs (:func:`grow_tree`);
+    ``tree`` the node positions ``(>= N, 2)`` and parents ``(>= N,)``, copied when kept."""
+    iterations, n, checks = counts
     path, segs, trace_iterations, trace_costs = arrays
     first_time, first_iteration = reached[math.inf]
+    keep = query.keep_tree
     return PlanResult(
         planner=planner,
         success=reason == "solved",
         stop_reason=reason,
         path=path,
-        cost=float(np.add.reduce(segs)) if g >= 0 else math.inf,  # = polyline_length(path)
-        iterations=int(c.iters[0]),
+        cost=float(np.add.reduce(segs)) if len(path) else math.inf,  # = polyline_length(path)
+        iterations=iterations,
         tree_size=n,
-        collision_checks=int(c.checks[0]),
+        collision_checks=checks,
         time_to_first=first_time,
         time_to_stop=elapsed,
-        first_cost=float(trace_costs[0]) if k else math.inf,
+        first_cost=float(trace_costs[0]) if len(trace_costs) else math.inf,
         first_iteration=first_iteration,
         trace_iterations=trace_iterations,
         trace_costs=trace_costs,
@@ -290,8 +287,8 @@ def result(
         fallback_uniform=query.fallback_uniform,
         setup_time=query.setup_time,
         budget=budget,
-        tree_points=t.pts[:n].copy() if query.keep_tree else None,
-        tree_parents=t.links[:n, nodes.PARENT].copy() if query.keep_tree else None,
+        tree_points=tree[0][:n].copy() if keep else None,
+        tree_parents=tree[1][:n].copy() if keep else None,
     )
 
 
@@ -301,30 +298,8 @@ def straight_result(planner: str, d: float, found: float, query: Query,
     straight segment of length ``d`` from start to goal: the tree is the root and the goal
     joined to it (one segment test). The cost is ``d``, equal to the polyline length of the
     path (both are libm's ``hypot``)."""
-    path, keep, bounds = np.array((query.start, query.goal)), query.keep_tree, query.bounds
-    return PlanResult(
-        planner=planner,
-        success=True,
-        stop_reason="solved",
-        path=path,
-        cost=d,
-        iterations=0,
-        tree_size=2,
-        collision_checks=1,
-        time_to_first=found,
-        time_to_stop=found,
-        first_cost=d,
-        first_iteration=0,
-        trace_iterations=np.zeros(1, np.int64),
-        trace_costs=np.array((d,)),
-        reference_length=query.reference_length,
-        target_cost=query.target,
-        milestones=tuple(Milestone(b, found, 0) if d <= b else Milestone(b) for b in bounds)
-        if bounds
-        else (),
-        fallback_uniform=query.fallback_uniform,
-        setup_time=query.setup_time,
-        budget=budget,
-        tree_points=path.copy() if keep else None,
-        tree_parents=np.array((-1, 0), np.int64) if keep else None,
-    )
+    path, cost = np.array((query.start, query.goal)), np.array((d,))
+    reached = {b: (found, 0) if d <= b else (math.nan, -1) for b in (math.inf, *query.bounds)}
+    return result(planner, query, budget, reason="solved", reached=reached, elapsed=found,
+                  counts=(0, 2, 1), arrays=(path, cost, np.zeros(1, np.int64), cost),
+                  tree=(path, np.array((-1, 0), np.int64)))  # fmt: skip
