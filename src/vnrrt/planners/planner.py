@@ -59,8 +59,7 @@ class Planner:
         heatmap: ``(H, W)`` non-negative sampling weights, needed by all but RRT*.
         config: every setting. Default :data:`~vnrrt.planners.USER`
             (``conf/planner/user.yaml``: our fastest settings, budgets scaled with the map's
-            free cells F: ``max(200000, ceil(50 F))`` iterations, ``max(30, 0.0002 F)``
-            seconds); the paper's protocol is :meth:`PlannerConfig.paper`.
+            free area); the paper's protocol is :meth:`PlannerConfig.paper`.
         sampler: a sampler already built by :func:`make_sampler` for this planner, map and
             config (then no ``heatmap``); checked against them.
 
@@ -171,17 +170,8 @@ def plan(
     keep_tree: bool = False,
 ) -> PlanResult:
     """Plan once from ``start`` to ``goal``: ``Planner(grid, planner, heatmap=heatmap,
-    config=config, sampler=sampler).solve(start, goal, stop=stop, ...)``.
-
-    ``grid`` ``(H, W)`` occupancy (nonzero = obstacle, ``grid[y, x]``); ``start``, ``goal``
-    continuous ``(x, y)`` pixels; ``planner`` one of :data:`PLANNERS` (all but RRT* sample
-    ``heatmap``, or a prebuilt ``sampler``); every setting in ``config`` (default
-    :data:`USER`, ``conf/planner/user.yaml``: our fastest settings with budgets scaled with
-    the map's free area, see :class:`Planner`; :meth:`PlannerConfig.paper` the paper's
-    protocol); ``stop`` ``'initial'`` or
-    ``'optimal'`` (cost <= (1 + eps) x ``reference_length``, None: ``config.reference``
-    computed); ``seed`` an int >= 0 or a tuple of them. Arguments and errors: :class:`Planner`
-    and :meth:`Planner.solve`. Returns a :class:`PlanResult`."""
+    config=config, sampler=sampler).solve(start, goal, stop=stop, ...)``; arguments, errors
+    and defaults there (:class:`Planner`, :meth:`Planner.solve`)."""
     p = Planner(grid, planner, heatmap=heatmap, config=config, sampler=sampler)
     return p.solve(start, goal, stop=stop, reference_length=reference_length, seed=seed,
                    milestones=milestones, keep_tree=keep_tree)  # fmt: skip

@@ -55,40 +55,6 @@ class Query(NamedTuple):
     fallback_uniform: bool
 
 
-class Tree:
-    """The arrays of a growing run (:mod:`.tree`): nodes, scratch buffers, counters, trace;
-    ``flat``: the same as plain tuples, as :func:`grow_tree` takes them (numba types a call's
-    plain tuples of arrays about 3x faster than named tuples)."""
-
-    def __init__(self, capacity: int, shape: tuple[int, int], bucket: float, trace: int):
-        self.tree = nodes.new_tree(capacity, shape, bucket)
-        self.scratch = nodes.new_scratch(capacity)
-        self.counters = nodes.new_counters()
-        self.trace = nodes.Trace(np.empty(trace, np.int64), np.empty(trace))
-        self._flatten()
-
-    def _flatten(self) -> None:
-        self.flat = tuple(self.tree), tuple(self.scratch), tuple(self.counters), tuple(self.trace)
-
-    def enlarge(self, max_iterations: int) -> None:
-        """Double a full tree's room, up to the budget's (root, goal and a node per
-        iteration), the tree kept."""
-        capacity = len(self.tree.cost)
-        if capacity >= max_iterations + 2:
-            raise RuntimeError(f"tree of {capacity} nodes full before the budget")
-        capacity = min(2 * capacity, max_iterations + 2)
-        self.tree = nodes.enlarge(self.tree, capacity)
-        self.scratch = nodes.new_scratch(capacity)
-        self._flatten()
-
-    def reset(self) -> None:
-        """Empty the tree, its arrays kept (a node's fields are written when it is added)."""
-        for count in self.counters:
-            count[0] = 0
-        self.counters.goal[0] = -1
-        self.tree.head.fill(-1)
-
-
 class Setup:
     """What every run of one planner on one map shares (as OMPL's ``setup()``), made when
     a run first needs it: the budgets (:attr:`budget`: fixed, or scaled with the map's free
@@ -100,7 +66,7 @@ class Setup:
 
     def __init__(self, occ: np.ndarray, cfg: PlannerConfig, sampler: Sampler):
         self.occ, self.cfg, self.sampler = occ, cfg, sampler
-        self._tree: Tree | None = None
+        self._tree: nodes.Arrays | None = None
 
     @functools.cached_property
     def budget(self) -> tuple[int, float]:
@@ -140,12 +106,14 @@ class Setup:
         cfg = self.cfg
         return tuple(self.sampler.draws(cfg.gap_share, cfg.gap_width, cfg.gap_after))
 
-    def fresh(self) -> Tree:
+    def fresh(self) -> nodes.Arrays:
         """An empty tree: allocated (:data:`FIRST_CAPACITY` nodes, or the budget's) by the
         first run, emptied by the next ones (kept as large as it grew)."""
         if self._tree is None:
             capacity = min(self.budget[0] + 2, FIRST_CAPACITY)
-            self._tree = Tree(capacity, self.occ.shape, self.bucket, self.cfg.trace_capacity)
+            self._tree = nodes.Arrays(
+                capacity, self.occ.shape, self.bucket, self.cfg.trace_capacity
+            )
         self._tree.reset()
         return self._tree
 
@@ -210,7 +178,7 @@ def grow_tree(occ, tree, scratch, counters, trace, rng, draws, stops, p, first, 
     """Plant the tree (when ``state[2]`` is 1) and grow it until the run is over; then its
     path, segment lengths, trace iterations and costs (:func:`vnrrt.planners.tree.finish`).
 
-    ``tree``, ``scratch``, ``counters``, ``trace`` (:attr:`Tree.flat`), ``draws`` and ``p``
+    ``tree``, ``scratch``, ``counters``, ``trace`` (:attr:`.tree.Arrays.flat`), ``draws`` and ``p``
     (``first``: those of planting) are plain tuples (:class:`Draws`, :class:`Params`);
     ``stops`` (M,) decreasing cost bounds; ``limits`` ``(target, max_iterations,
     max_seconds, t0)`` (target ``inf``: the first solution; ``t0``: the run's start on the

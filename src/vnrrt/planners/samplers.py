@@ -18,7 +18,6 @@ seeded by :class:`numpy.random.SeedSequence` (:func:`rng_state`).
 
 from __future__ import annotations
 
-import functools
 import math
 from dataclasses import dataclass
 from typing import NamedTuple
@@ -115,15 +114,8 @@ class Sampler:
 
 
 def uniform_sampler(shape: tuple[int, int]) -> Sampler:
-    """Uniform sampler over the ``(H, W)`` map (one per shape: it holds nothing else)."""
-    return _uniform((int(shape[0]), int(shape[1])))
-
-
-@functools.lru_cache(maxsize=64)
-def _uniform(shape: tuple[int, int]) -> Sampler:
-    no_weights = np.zeros(0)
-    no_weights.flags.writeable = False
-    return Sampler("uniform", 0.0, no_weights, -1, shape)
+    """Uniform sampler over the ``(H, W)`` map."""
+    return Sampler("uniform", 0.0, np.zeros(0), -1, (int(shape[0]), int(shape[1])))
 
 
 def heatmap_sampler(
