@@ -67,7 +67,7 @@ def test_masked_never_below_tau(heat, tau):
 
 
 def test_masked_falls_back_to_uniform_when_empty(heat):
-    s = make_sampler("m_vnrrt_star", heat.shape, heat, PlannerConfig(tau=2.0))
+    s = make_sampler("m_vnrrt_star", heat.shape, heat, config=PlannerConfig(tau=2.0))
     assert s.fallback_uniform and s.draws().mix == 0.0 and s.mix == 0.5 and s.tau == 2.0
     assert not make_sampler("vnrrt_star", heat.shape, heat).fallback_uniform
 

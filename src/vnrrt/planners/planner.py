@@ -29,7 +29,7 @@ log = logging.getLogger(__name__)
 
 
 def make_sampler(
-    planner: str, shape: tuple[int, int], heatmap=None, config: PlannerConfig | None = None
+    planner: str, shape: tuple[int, int], heatmap=None, *, config: PlannerConfig | None = None
 ) -> Sampler:
     """The sampler of ``planner`` for an ``(H, W)`` map (see :mod:`.samplers`), built with
     ``config.mix`` and, for M-VNRRT*, ``config.tau``."""
@@ -42,7 +42,7 @@ def make_sampler(
     if heatmap is None:
         raise ValueError(f"{planner} needs a heatmap of shape {tuple(shape)}")
     tau = cfg.tau if planner == "m_vnrrt_star" else None
-    return heatmap_sampler(heatmap, shape, cfg.mix, tau)
+    return heatmap_sampler(heatmap, shape, mix=cfg.mix, tau=tau)
 
 
 class Planner:
@@ -59,7 +59,8 @@ class Planner:
         heatmap: ``(H, W)`` non-negative sampling weights, needed by all but RRT*.
         config: every setting. Default :data:`~vnrrt.planners.USER`
             (``conf/planner/user.yaml``: our fastest settings, budgets scaled with the map's
-            free area); the paper's protocol is :meth:`PlannerConfig.paper`.
+            free cells F: ``max(200000, ceil(50 F))`` iterations, ``max(30, 0.0002 F)``
+            seconds); the paper's protocol is :meth:`PlannerConfig.paper`.
         sampler: a sampler already built by :func:`make_sampler` for this planner, map and
             config (then no ``heatmap``); checked against them.
 
@@ -83,7 +84,7 @@ class Planner:
         self.setup_time = 0.0
         if sampler is None:
             t0 = time.perf_counter()
-            sampler = make_sampler(planner, self.occ.shape, heatmap, self.config)
+            sampler = make_sampler(planner, self.occ.shape, heatmap, config=self.config)
             self.setup_time = time.perf_counter() - t0
         elif heatmap is not None:
             raise ValueError("give either a prebuilt sampler or a heatmap, not both")

@@ -1,19 +1,16 @@
-"""One timed planner run on a checked query: the run's settings and tree arrays, the compiled
-loop that grows the tree (:func:`grow_tree`) and the :class:`PlanResult` built from it.
+"""One timed planner run on a checked query: the settings and arrays runs share
+(:class:`Setup`), the compiled loop that grows the tree (:func:`grow_tree`) and the
+:class:`PlanResult` built from it. ``occ`` is the ``(H, W)`` uint8 grid indexed ``occ[y, x]``
+(nonzero = obstacle), points ``(x, y)`` pixels, times seconds on ``time.perf_counter``'s clock.
 
-Coordinates follow :mod:`vnrrt.grid`: ``occ`` is the ``(H, W)`` uint8 grid indexed
-``occ[y, x]`` (nonzero = obstacle), points are continuous ``(x, y)`` pixels, lengths pixels,
-times seconds on ``time.perf_counter``'s clock.
-
-The clock starts before the straight start-goal segment is tested (when ``straight_first``;
-a free segment that meets the stop rule is the exact optimum and ends the run, a two-node
-tree) and stops when the stop rule or a budget is met and the path and trace are taken out
-of the tree (as OMPL's ``solve()`` builds its solution path). The tree grows in one compiled
-call: chunks of :func:`vnrrt.planners.rrt_star.grow` (:data:`FIRST_CHUNK` iterations first,
-doubling up to :data:`MAX_CHUNK`), the budgets checked and the bounds' first-pass times
-taken between chunks; it returns to Python when the run is over or the tree's arrays are
-full (then enlarged, inside the clock). The arrays are allocated or emptied before the
-clock starts, as OMPL's ``setup()`` is outside its ``solve()`` times.
+The clock starts before the straight start-goal segment is tested (``straight_first``: a free
+segment that meets the stop rule is the exact optimum and ends the run) and stops when the
+stop rule or a budget is met and the path and trace are out of the tree (as OMPL's
+``solve()``). The tree grows in chunks of :func:`vnrrt.planners.rrt_star.grow`
+(:data:`FIRST_CHUNK` iterations, doubling up to :data:`MAX_CHUNK`), the budgets checked and
+the bounds' first-pass times taken between chunks, in one compiled call that returns when
+the run is over or the tree is full (enlarged inside the clock). The arrays are allocated or
+emptied before the clock starts, as OMPL's ``setup()`` is outside its ``solve()`` times.
 """
 
 from __future__ import annotations
@@ -56,13 +53,10 @@ class Query(NamedTuple):
 
 
 class Setup:
-    """What every run of one planner on one map shares (as OMPL's ``setup()``), made when
-    a run first needs it: the budgets (:attr:`budget`: fixed, or scaled with the map's free
-    cells by the budget rule, :meth:`PlannerConfig.budgets`) and, from the first tree run on
-    (a straight answer needs none), the core's settings (:attr:`params`,
-    :class:`~vnrrt.planners.rrt_star.Params`, the query's start and goal left at 0), the
-    sampler as the core reads it (:attr:`draws`) and the tree's arrays (:meth:`fresh`; one
-    run at a time)."""
+    """What every run of one planner on one map shares (as OMPL's ``setup()``), each made
+    when a run first needs it (a straight answer needs only the budget): the budgets, the
+    core's settings, the sampler as the core reads it and the tree's arrays (one run at a
+    time)."""
 
     def __init__(self, occ: np.ndarray, cfg: PlannerConfig, sampler: Sampler):
         self.occ, self.cfg, self.sampler = occ, cfg, sampler
@@ -70,8 +64,7 @@ class Setup:
 
     @functools.cached_property
     def budget(self) -> tuple[int, float]:
-        """``(max_iterations, max_seconds)`` on this map (free cells counted only when the
-        config scales a budget with them)."""
+        """``(max_iterations, max_seconds)`` on this map (:meth:`PlannerConfig.budgets`)."""
         free = self.occ.size - np.count_nonzero(self.occ) if self.cfg.scales_budgets else 0
         return self.cfg.budgets(free)
 
@@ -83,7 +76,7 @@ class Setup:
 
     @functools.cached_property
     def params(self) -> Params:
-        """The core's settings (the config's and the map's gamma)."""
+        """The core's settings (the config's and the map's gamma; start and goal 0)."""
         cfg = self.cfg
         return Params(
             eta=float(cfg.eta),
@@ -101,14 +94,16 @@ class Setup:
 
     @functools.cached_property
     def draws(self) -> tuple:
-        """The sampler and the gap sampler as the core reads them (a plain :class:`Draws`;
-        the gap cells, when used, found in the run)."""
+        """The sampler and the gap sampler as the core reads them (a plain :class:`Draws`)."""
         cfg = self.cfg
-        return tuple(self.sampler.draws(cfg.gap_share, cfg.gap_width, cfg.gap_after))
+        draws = self.sampler.draws(
+            gap_share=cfg.gap_share, gap_width=cfg.gap_width, gap_after=cfg.gap_after
+        )
+        return tuple(draws)
 
     def fresh(self) -> nodes.Arrays:
         """An empty tree: allocated (:data:`FIRST_CAPACITY` nodes, or the budget's) by the
-        first run, emptied by the next ones (kept as large as it grew)."""
+        first run, emptied by the next ones."""
         if self._tree is None:
             capacity = min(self.budget[0] + 2, FIRST_CAPACITY)
             self._tree = nodes.Arrays(
@@ -120,8 +115,7 @@ class Setup:
 
 def gamma(occ: np.ndarray, cfg: PlannerConfig) -> float:
     """The shrinking-radius constant: ``cfg.gamma_factor`` x (``cfg.gamma``, or the RRT*
-    bound ``2 (1 + 1/d)^(1/d) (free area / unit-ball area)^(1/d)``, d = 2, of the map
-    ``occ``, its free area in cells)."""
+    bound ``2 sqrt(1.5) sqrt(F / pi)`` of the map ``occ`` of F free cells)."""
     factor = float(cfg.gamma_factor)
     if cfg.gamma is not None:
         return factor * float(cfg.gamma)
@@ -175,19 +169,17 @@ def stop_bounds(query: Query) -> np.ndarray:
 @njit(cache=True)
 def grow_tree(occ, tree, scratch, counters, trace, rng, draws, stops, p, first, limits, state,
               times, iters):  # fmt: skip
-    """Plant the tree (when ``state[2]`` is 1) and grow it until the run is over; then its
-    path, segment lengths, trace iterations and costs (:func:`vnrrt.planners.tree.finish`).
+    """Plant the tree (when ``state[2]`` is 1) and grow it until the run is over; returns
+    ``(code, path, segs, trace_iters, trace_costs)`` (:func:`vnrrt.planners.tree.finish`;
+    empty when ``code`` is :data:`~vnrrt.planners.rrt_star.TREE_FULL`: enlarge, call again).
 
-    ``tree``, ``scratch``, ``counters``, ``trace`` (:attr:`.tree.Arrays.flat`), ``draws`` and ``p``
-    (``first``: those of planting) are plain tuples (:class:`Draws`, :class:`Params`);
+    ``tree``, ``scratch``, ``counters``, ``trace`` (:attr:`.tree.Arrays.flat`), ``draws`` and
+    ``p`` (``first``: those of planting) are plain tuples (:class:`Draws`, :class:`Params`);
     ``stops`` (M,) decreasing cost bounds; ``limits`` ``(target, max_iterations,
     max_seconds, t0)`` (target ``inf``: the first solution; ``t0``: the run's start on the
     clock, seconds); ``state`` (3,) int64 kept across calls: next chunk size, bounds passed,
     plant first; ``times`` (M,) float64 and ``iters`` (M,) int64: when each bound was first
-    passed (NaN / -1: never). Returns ``(code, path, segs, trace_iters, trace_costs)``, the
-    code :data:`SOLVED`, :data:`MAX_ITERATIONS`, :data:`MAX_SECONDS` or
-    :data:`~vnrrt.planners.rrt_star.TREE_FULL` (the arrays then empty: the caller enlarges
-    the tree and calls again).
+    passed (NaN / -1: never).
     """
     t, c, tr = nodes.Tree(*tree), nodes.Counters(*counters), nodes.Trace(*trace)
     scratch, draws, p = nodes.Scratch(*scratch), Draws(*draws), Params(*p)

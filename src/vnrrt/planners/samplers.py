@@ -101,7 +101,7 @@ class Sampler:
     fallback_uniform: bool = False
     tau: float | None = None
 
-    def draws(self, gap_share=0.0, gap_width=8, gap_after=0, cells=None) -> Draws:
+    def draws(self, *, gap_share=0.0, gap_width=8, gap_after=0, cells=None) -> Draws:
         """This sampler as the compiled draw reads it, with the gap sampler's settings and
         flat ``cells`` (None: pending, found by the run when ``gap_share > 0``). Without
         weights (uniform, or after a fallback) no heatmap draw is made (``mix`` 0)."""
@@ -119,7 +119,7 @@ def uniform_sampler(shape: tuple[int, int]) -> Sampler:
 
 
 def heatmap_sampler(
-    heatmap: np.ndarray, shape: tuple[int, int], mix: float = 0.5, tau: float | None = None
+    heatmap: np.ndarray, shape: tuple[int, int], *, mix: float = 0.5, tau: float | None = None
 ) -> Sampler:
     """Heatmap sampler (``tau=None``) or masked sampler (weights below ``tau`` zeroed).
 
@@ -265,7 +265,7 @@ def _draw(s, count, h, w, d, ellipse):
     return out
 
 
-def draw(sampler: Sampler, n: int, seed=0, ellipse=None, gaps=None) -> np.ndarray:
+def draw(sampler: Sampler, n: int, *, seed=0, ellipse=None, gaps=None) -> np.ndarray:
     """``n`` samples ``(n, 2)`` float64 (x, y) in pixels from ``sampler`` (for tests, plots);
     ``ellipse=(start, goal, c_best)`` draws the informed samples of a run whose best solution
     costs ``c_best``; ``gaps=(share, cells)`` mixes in the gap sampler's draws as a planner
@@ -273,6 +273,6 @@ def draw(sampler: Sampler, n: int, seed=0, ellipse=None, gaps=None) -> np.ndarra
     gap_cells`)."""
     (sx, sy), (gx, gy), c_best = ellipse if ellipse is not None else ((0, 0), (0, 0), 0.0)
     share, cells = (gaps[0], np.asarray(gaps[1], np.int64)) if gaps is not None else (0.0, None)
-    d = sampler.draws(share, cells=cells)
+    d = sampler.draws(gap_share=share, cells=cells)
     ends = (ellipse is not None, float(sx), float(sy), float(gx), float(gy), float(c_best))
     return _draw(rng_state(seed), int(n), *sampler.shape, d, ends)
