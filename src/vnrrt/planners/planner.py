@@ -138,11 +138,11 @@ class Planner:
                ) -> run.Query:  # fmt: skip
         """The checked query of :meth:`solve` (arguments and errors there), its reference
         computed when ``stop`` is ``'optimal'`` and none is given."""
-        arguments.check_stop_target(stop, reference_length, start, goal, self.config)
         start = arguments.endpoint(self.occ, start, "start")
         goal = arguments.endpoint(self.occ, goal, "goal")
         if stop != "initial" and stop != "optimal":
             raise ValueError(f"unknown stop rule {stop!r}; use 'initial' or 'optimal'")
+        arguments.check_stop_target(stop, reference_length, start, goal, self.config)
         arguments.check_seed(seed)
         if stop == "initial":
             target = None
