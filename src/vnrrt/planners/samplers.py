@@ -201,12 +201,10 @@ def in_ellipse(x, y, sx, sy, gx, gy, c_best):
 def ellipse_uniform(s, h, w, sx, sy, gx, gy, c_best):
     """A uniform point of the ellipse (foci start and goal, major axis ``c_best``) inside the
     map ``[0, W) x [0, H)``, by rejection from the smaller of two regions that hold it: the
-    ellipse itself (points outside the map rejected) or the map part of the ellipse's
-    axis-aligned bounding box (points outside the ellipse rejected). The start-goal segment
-    lies in both the map and the ellipse, so the acceptance rate stays high (0.77 the lowest
-    over 3,000 random map sizes, endpoints and costs); after :data:`INFORMED_TRIES`
-    rejections (never seen) a uniform point of that segment is returned, so a draw is never
-    outside the ellipse or the map."""
+    ellipse (points outside the map rejected) or the map part of its bounding box (points
+    outside the ellipse rejected); acceptance is at least 0.77 over 3,000 random map sizes,
+    endpoints and costs. After :data:`INFORMED_TRIES` rejections (never seen) a uniform
+    point of the start-goal segment (in both) is returned."""
     c_min = math.hypot(gx - sx, gy - sy)
     a = 0.5 * c_best
     b = 0.5 * math.sqrt(max(c_best * c_best - c_min * c_min, 0.0))
@@ -238,12 +236,10 @@ def ellipse_uniform(s, h, w, sx, sy, gx, gy, c_best):
 def any_point(s, h, w, d, ellipse):
     """One sample ``(x, y)`` (pixels) of the sampler ``d`` (a :class:`Draws`), ``s`` the rng
     state: with probability ``d.gap_share`` (when gap cells exist) a gap sampler's draw, else
-    with probability ``d.mix`` a heatmap draw, else a uniform point of the map. ``ellipse``
-    is ``(informed, sx, sy, gx, gy, c_best)``: when informed, a gap or heatmap draw is
-    conditioned on the ellipse of ``c_best`` (rejection: at most :data:`HEATMAP_TRIES`
-    draws; when all fall outside, there is next to no mass in the ellipse and the sample is
-    uniform there instead) and a uniform point is one of the ellipse inside the map
-    (:func:`ellipse_uniform`). A share or mix of 0 spends no random number on its choice."""
+    with probability ``d.mix`` a heatmap draw, else a uniform point of the map (a share or
+    mix of 0 spends no random number). ``ellipse`` is ``(informed, sx, sy, gx, gy, c_best)``:
+    when informed, a gap or heatmap draw is rejected outside the ellipse of ``c_best`` (at
+    most :data:`HEATMAP_TRIES` times, then a uniform point of it: :func:`ellipse_uniform`)."""
     informed, sx, sy, gx, gy, c_best = ellipse
     gap = d.gap_share > 0.0 and d.n_gaps > 0 and next_double(s) < d.gap_share
     if not gap and not (d.mix > 0.0 and next_double(s) < d.mix):
