@@ -114,14 +114,13 @@ class PlannerConfig:
     @classmethod
     def named(cls, option: str) -> PlannerConfig:
         """The validated settings of ``conf/planner/<option>.yaml`` as Hydra composes the
-        option (``default``, ``fastest``, ``user``); :class:`PlannerConfigError` names an
-        unknown key, :class:`vnrrt.config.ConfigError` a missing file."""
+        option (``default``, ``fastest``, ``user``); :class:`PlannerConfigError` names the file
+        and an unknown key or invalid value, :class:`vnrrt.config.ConfigError` a missing file."""
         values = config.conf_file("planner", option)
-        known = {f.name for f in dataclasses.fields(cls)}
-        unknown = sorted(set(values) - known)
-        if unknown:
-            raise PlannerConfigError(f"conf/planner/{option}.yaml: unknown setting(s) {unknown}")
-        return cls().replace(**values)
+        try:
+            return cls().replace(**values)
+        except PlannerConfigError as e:
+            raise PlannerConfigError(f"conf/planner/{option}.yaml: {e}") from None
 
     @property
     def scales_budgets(self) -> bool:
