@@ -473,7 +473,7 @@ def test_a_runs_core_settings_are_its_configs_and_its_querys(cfg, planner):
     ],
 )
 def test_a_prebuilt_sampler_is_checked_against_the_config(grid, heat, built, config, kwargs, match):
-    sampler = make_sampler("m_vnrrt_star", grid.shape, heat, PlannerConfig(**built))
+    sampler = make_sampler("m_vnrrt_star", grid.shape, heat, config=PlannerConfig(**built))
     args = {"planner": "m_vnrrt_star", "config": PlannerConfig(**config), **kwargs}
     with pytest.raises(ValueError, match=match):
         plan(grid, START, GOAL, sampler=sampler, **args)

@@ -21,7 +21,7 @@ from vnrrt.planners import (
 )
 from vnrrt.planners import tree as nodes
 from vnrrt.planners.collision import segment_free
-from vnrrt.planners.seeding import rng_state
+from vnrrt.planners.samplers import rng_state
 
 
 def wall() -> np.ndarray:
@@ -33,8 +33,9 @@ def wall() -> np.ndarray:
 
 def chain(points, goal_last=True):
     """A tree that is one chain root -> ... -> last through ``points``, with its counters."""
-    t = nodes.new_tree(64, (40, 40), 5.0)
-    c = nodes.new_counters()
+    arrays = nodes.Arrays(64, (40, 40), 5.0, 8)
+    arrays.reset()
+    t, c = arrays.tree, arrays.counters
     parent, cost = -1, 0.0
     for i, (x, y) in enumerate(points):
         if i:

@@ -234,9 +234,16 @@ def test_tree_memory_follows_the_work_done_not_the_budget(monkeypatch):
     up to the budget (+ root and goal)."""
     warmup()  # its own small runs first
     sizes = []
-    new_tree, enlarge = nodes.new_tree, nodes.enlarge
-    monkeypatch.setattr(nodes, "new_tree", lambda c, *a: sizes.append(c) or new_tree(c, *a))
-    monkeypatch.setattr(nodes, "enlarge", lambda t, c: sizes.append(c) or enlarge(t, c))
+
+    def recorded(method):
+        def call(arrays, *args):
+            method(arrays, *args)
+            sizes.append(len(arrays.tree.cost))
+
+        return call
+
+    monkeypatch.setattr(nodes.Arrays, "__init__", recorded(nodes.Arrays.__init__))
+    monkeypatch.setattr(nodes.Arrays, "enlarge", recorded(nodes.Arrays.enlarge))
     fm = named_map("cluttered", 200)
     s, g = fm.starts[0] + 0.5, fm.goals[0] + 0.5
     r = plan(fm.grid, s, g, config=PlannerConfig(max_iterations=10**9), seed=0)

@@ -6,7 +6,6 @@ from scipy import stats
 
 from vnrrt.grid import GridError
 from vnrrt.planners import PlannerConfig, draw, heatmap_sampler, make_sampler, uniform_sampler
-from vnrrt.planners.seeding import rng_state
 
 N = 200_000
 
@@ -68,7 +67,7 @@ def test_masked_never_below_tau(heat, tau):
 
 
 def test_masked_falls_back_to_uniform_when_empty(heat):
-    s = make_sampler("m_vnrrt_star", heat.shape, heat, PlannerConfig(tau=2.0))
+    s = make_sampler("m_vnrrt_star", heat.shape, heat, config=PlannerConfig(tau=2.0))
     assert s.fallback_uniform and s.draws().mix == 0.0 and s.mix == 0.5 and s.tau == 2.0
     assert not make_sampler("vnrrt_star", heat.shape, heat).fallback_uniform
 
@@ -124,24 +123,3 @@ def test_probability_maps_keep_their_draws_bit_for_bit(tau):
     assert np.array_equal(s.cdf, raw) and s.cdf[-1] == raw[-1]
     ones = heatmap_sampler(np.ones((200, 200)), (200, 200))
     assert np.array_equal(ones.cdf, np.arange(1.0, 40_001.0))  # max 1: not rescaled either
-
-
-def numpy_state(seed) -> np.ndarray:
-    state = np.random.SeedSequence(seed).generate_state(4, dtype=np.uint64)
-    state[0] += not state.any()
-    return state
-
-
-def test_the_compiled_seeding_is_numpys_seed_sequence_bit_for_bit():
-    """rng_state reimplements SeedSequence(seed).generate_state(4, uint64) in a kernel: the
-    same state for ints of any size, tuples and lists (the evaluation's 63-bit trial seeds,
-    the benchmarks' tuples) and the edge cases of numpy's word assembly."""
-    rng = np.random.default_rng(0)
-    seeds = [0, 1, 2**32 - 1, 2**32, 2**63 - 1, 2**64 + 5, 2**130 + 7, (), (0,), [1, 2, 3, 4, 5]]
-    seeds += [int(v) for v in rng.integers(0, 2**63, 500)]
-    seeds += [tuple(int(v) for v in rng.integers(0, 2**40, rng.integers(1, 7))) for _ in range(500)]
-    for seed in seeds:
-        np.testing.assert_array_equal(rng_state(seed), numpy_state(seed), err_msg=str(seed))
-    assert rng_state(np.int64(7)).dtype == np.uint64
-    with pytest.raises(TypeError):
-        rng_state(1.5)

@@ -46,17 +46,18 @@ def build_sampler(
         config = config.replace(mix=float(key.mix))
     shape = allowed.shape
     if not free:
-        s = make_sampler(key.planner, shape, heatmap, config)
+        s = make_sampler(key.planner, shape, heatmap, config=config)
         return s, config, s.fallback_uniform
     uniform = allowed / allowed.sum()
     if key.planner == "rrt_star":
-        s = heatmap_sampler(uniform, shape, 1.0)
+        s = heatmap_sampler(uniform, shape, mix=1.0)
         return dataclasses.replace(s, kind="uniform"), config, False
-    masked = make_sampler(key.planner, shape, heatmap, config)
+    masked = make_sampler(key.planner, shape, heatmap, config=config)
     weights = np.asarray(heatmap, np.float64)
     if key.tau is not None:
         weights = np.where(weights >= key.tau, weights, 0.0)
     total = weights.sum()
     mixture = uniform if total <= 0 else config.mix * weights / total + (1 - config.mix) * uniform
-    s = dataclasses.replace(heatmap_sampler(mixture, shape, 1.0), kind=masked.kind, tau=masked.tau)
+    s = heatmap_sampler(mixture, shape, mix=1.0)
+    s = dataclasses.replace(s, kind=masked.kind, tau=masked.tau)
     return s, config.replace(mix=1.0), masked.fallback_uniform

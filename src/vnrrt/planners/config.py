@@ -31,64 +31,52 @@ class PlannerConfigError(ValueError):
 @config.conf_defaults("planner", exact=True, error=PlannerConfigError)
 class PlannerConfig:
     """RRT* core, samplers, stop rules and budgets (paper, Background and VertexNet RRT*).
+    Lengths in pixels, times in seconds; "ours" marks an option off in the paper's protocol.
 
     Attributes:
-        eta: Steer step (pixels).
+        eta: Steer step.
         radius_mode: ``'shrinking'``: near radius ``min(gamma sqrt(log n / n), eta)``;
             ``'fixed'``: ``fixed_radius``.
         gamma: shrinking-radius constant; ``None`` uses the RRT* bound
             ``2 sqrt(1.5) sqrt(free area / pi)`` of the map (Karaman and Frazzoli).
-        gamma_factor: the shrinking radius's constant is ``gamma_factor x gamma`` (below 1
-            the radius falls below ``eta`` within a run: the regime sweep's radius rules).
-        fixed_radius: near radius in ``'fixed'`` mode (pixels).
-        goal_radius: a node within this distance connects to the goal point by a
-            collision-free straight segment; ``None`` means ``eta``; ``.inf``: any node
-            that sees the goal.
+        gamma_factor: the shrinking radius uses ``gamma_factor x gamma`` (below 1 it falls
+            below ``eta`` within a run: the regime sweep's radius rules).
+        fixed_radius: near radius in ``'fixed'`` mode.
+        goal_radius: a node this close connects to the goal point by a free straight
+            segment; ``None``: ``eta``; ``.inf``: any node that sees the goal.
         mix: probability of a heatmap draw in NRRT*/VNRRT*/M-VNRRT* (Algorithm 2: 0.5).
-        tau: mask threshold of M-VNRRT* (pixels with heatmap value below it get no weight).
+        tau: mask threshold of M-VNRRT* (heatmap values below it get no weight).
         taus: thresholds evaluated for M-VNRRT* (paper: 0.5, 0.9, 0.99).
         eps: stop rule ``optimal``: best cost <= (1 + eps) x reference length.
-        reference: ``'astar'`` (paper: 8-connected A* length), ``'any_angle'`` (the exact
-            continuous optimum among closed obstacle cells, :func:`vnrrt.search.any_angle_length`)
-            or ``'taut'`` (the A* path pulled taut: an approximation, 0-6% above the exact).
-        min_spacing: a sample within this distance (pixels) of its nearest node adds no
-            node (the iteration counts). Without it, a concentrated heatmap (M-VNRRT*)
-            draws many samples inside the same few pixels, RRT* piles nodes up there and
-            every near search and rewire grows with the pile; 0 disables it.
-        informed: Informed RRT* (Gammell et al. 2014): once a solution of cost c exists,
-            sample (uniform and heatmap draws) inside the ellipse with foci start and goal
-            and major axis c, and skip nodes that cannot improve the solution
-            (:mod:`vnrrt.planners.rrt_star`). Off in the paper's protocol.
-        straight_first: try the straight start-goal segment first (any length): when it is
-            free it is the optimum and the run ends at once. Off in the paper's protocol.
-        refine: share of the iterations, once a solution exists, that are path-refinement
-            moves instead of samples (:mod:`vnrrt.planners.refine`: shortcut or move a vertex
-            of the best path); 0 (the paper's protocol) disables it.
-        pull_parents: a new node's parent is the furthest ancestor of the chosen parent that
-            sees it (Theta*'s any-angle parent), so branches are pulled taut round obstacle
-            corners as they grow. Off in the paper's protocol.
+        reference: the reference length's kind, ``'astar'`` (the paper's), ``'any_angle'``
+            or ``'taut'`` (:mod:`vnrrt.planners.reference`).
+        min_spacing: a sample this close to its nearest node adds no node (the iteration
+            counts), so that a concentrated heatmap (M-VNRRT*) does not pile nodes up in a
+            few pixels, slowing every near search and rewire; 0 disables it.
+        informed: ours, Informed RRT* (Gammell et al. 2014): once a solution of cost c
+            exists, sample inside the ellipse with foci start and goal and major axis c, and
+            skip nodes that cannot improve it (:mod:`vnrrt.planners.rrt_star`).
+        straight_first: ours, try the straight start-goal segment first: when free it is
+            the optimum and the run ends at once.
+        refine: ours, share of the iterations, once a solution exists, that are local moves
+            on the best path instead of samples (:mod:`vnrrt.planners.refine`).
+        pull_parents: ours, a new node's parent is the furthest ancestor of the chosen
+            parent that sees it (Theta*'s any-angle parent).
         refine_branches: share of the refinement moves made on the branch of a random tree
             node that could still lead to a better solution, rather than on the best path.
-        gap_share: share of the samples drawn from the map's narrow-passage cells (free
-            cells whose free run along the row or column is at most ``gap_width`` cells:
-            :mod:`vnrrt.planners.gaps`, an axis-aligned grid form of the bridge test) instead
-            of the sampler; 0 (the paper's protocol) disables it. The cells are found by each
-            run after ``gap_after`` iterations (inside its timed region: 20-70 us on a
-            200 x 200 map; again after the tree's arrays were enlarged), so that runs ending
-            before it pay nothing for them.
+        gap_share: ours, share of the samples drawn from the narrow-passage cells of width
+            at most ``gap_width`` cells (:mod:`vnrrt.planners.gaps`), found by each run
+            (inside its timed region) after ``gap_after`` iterations.
         gap_width: widest passage (cells) whose cells the gap sampler draws.
         gap_after: iterations before the gap sampler's first draw.
         max_iterations, max_seconds: budgets; hitting one is a recorded failure. With the
             budget rule on, the floors of the map's budgets (:meth:`budgets`).
-        iterations_per_free_cell, seconds_per_free_cell: the budget rule: on a map of F free
-            cells, ``max_iterations`` becomes ``max(max_iterations, ceil(k F))`` and
-            ``max_seconds`` ``max(max_seconds, k F)`` with ``k`` these (None: the budget is
-            fixed, as in the paper's protocol).
+        iterations_per_free_cell, seconds_per_free_cell: the budget rule (:meth:`budgets`);
+            None: the budget is fixed, as in the paper's protocol.
         trace_capacity: most points kept in the sparse cost-versus-iteration trace.
 
-    Frozen: a config is changed by :meth:`replace`, which validates the copy, so a config
-    that passed :meth:`validate` stays valid (the check is remembered, and repeated calls
-    cost nothing).
+    Frozen: :meth:`replace` validates the copy, so a config that passed :meth:`validate`
+    stays valid (the check is remembered).
     """
 
     eta: float
@@ -126,14 +114,13 @@ class PlannerConfig:
     @classmethod
     def named(cls, option: str) -> PlannerConfig:
         """The validated settings of ``conf/planner/<option>.yaml`` as Hydra composes the
-        option (``default``, ``fastest``, ``user``); :class:`PlannerConfigError` names an
-        unknown key, :class:`vnrrt.config.ConfigError` a missing file."""
+        option (``default``, ``fastest``, ``user``); :class:`PlannerConfigError` names the file
+        and an unknown key or invalid value, :class:`vnrrt.config.ConfigError` a missing file."""
         values = config.conf_file("planner", option)
-        known = {f.name for f in dataclasses.fields(cls)}
-        unknown = sorted(set(values) - known)
-        if unknown:
-            raise PlannerConfigError(f"conf/planner/{option}.yaml: unknown setting(s) {unknown}")
-        return cls().replace(**values)
+        try:
+            return cls().replace(**values)
+        except PlannerConfigError as e:
+            raise PlannerConfigError(f"conf/planner/{option}.yaml: {e}") from None
 
     @property
     def scales_budgets(self) -> bool:

@@ -29,7 +29,7 @@ log = logging.getLogger(__name__)
 
 
 def make_sampler(
-    planner: str, shape: tuple[int, int], heatmap=None, config: PlannerConfig | None = None
+    planner: str, shape: tuple[int, int], heatmap=None, *, config: PlannerConfig | None = None
 ) -> Sampler:
     """The sampler of ``planner`` for an ``(H, W)`` map (see :mod:`.samplers`), built with
     ``config.mix`` and, for M-VNRRT*, ``config.tau``."""
@@ -42,7 +42,7 @@ def make_sampler(
     if heatmap is None:
         raise ValueError(f"{planner} needs a heatmap of shape {tuple(shape)}")
     tau = cfg.tau if planner == "m_vnrrt_star" else None
-    return heatmap_sampler(heatmap, shape, cfg.mix, tau)
+    return heatmap_sampler(heatmap, shape, mix=cfg.mix, tau=tau)
 
 
 class Planner:
@@ -84,7 +84,7 @@ class Planner:
         self.setup_time = 0.0
         if sampler is None:
             t0 = time.perf_counter()
-            sampler = make_sampler(planner, self.occ.shape, heatmap, self.config)
+            sampler = make_sampler(planner, self.occ.shape, heatmap, config=self.config)
             self.setup_time = time.perf_counter() - t0
         elif heatmap is not None:
             raise ValueError("give either a prebuilt sampler or a heatmap, not both")
@@ -138,11 +138,11 @@ class Planner:
                ) -> run.Query:  # fmt: skip
         """The checked query of :meth:`solve` (arguments and errors there), its reference
         computed when ``stop`` is ``'optimal'`` and none is given."""
-        arguments.check_stop_target(stop, reference_length, start, goal, self.config)
         start = arguments.endpoint(self.occ, start, "start")
         goal = arguments.endpoint(self.occ, goal, "goal")
         if stop != "initial" and stop != "optimal":
             raise ValueError(f"unknown stop rule {stop!r}; use 'initial' or 'optimal'")
+        arguments.check_stop_target(stop, reference_length, start, goal, self.config)
         arguments.check_seed(seed)
         if stop == "initial":
             target = None
@@ -171,17 +171,8 @@ def plan(
     keep_tree: bool = False,
 ) -> PlanResult:
     """Plan once from ``start`` to ``goal``: ``Planner(grid, planner, heatmap=heatmap,
-    config=config, sampler=sampler).solve(start, goal, stop=stop, ...)``.
-
-    ``grid`` ``(H, W)`` occupancy (nonzero = obstacle, ``grid[y, x]``); ``start``, ``goal``
-    continuous ``(x, y)`` pixels; ``planner`` one of :data:`PLANNERS` (all but RRT* sample
-    ``heatmap``, or a prebuilt ``sampler``); every setting in ``config`` (default
-    :data:`USER`, ``conf/planner/user.yaml``: our fastest settings with budgets scaled with
-    the map's free area, see :class:`Planner`; :meth:`PlannerConfig.paper` the paper's
-    protocol); ``stop`` ``'initial'`` or
-    ``'optimal'`` (cost <= (1 + eps) x ``reference_length``, None: ``config.reference``
-    computed); ``seed`` an int >= 0 or a tuple of them. Arguments and errors: :class:`Planner`
-    and :meth:`Planner.solve`. Returns a :class:`PlanResult`."""
+    config=config, sampler=sampler).solve(start, goal, stop=stop, ...)``; arguments, errors
+    and defaults there (:class:`Planner`, :meth:`Planner.solve`)."""
     p = Planner(grid, planner, heatmap=heatmap, config=config, sampler=sampler)
     return p.solve(start, goal, stop=stop, reference_length=reference_length, seed=seed,
                    milestones=milestones, keep_tree=keep_tree)  # fmt: skip
@@ -192,14 +183,9 @@ def warmup() -> None:
     """Compile (or load from numba's disk cache) every kernel once per process, so that
     reported timings exclude JIT compilation."""
     occ = np.zeros((8, 8), np.uint8)
-    occ[2:6, 4] = 1
-    heat = np.ones((8, 8))
+    occ[2:6, 4] = 1  # a wall: the straight segment tested and blocked, the tree grown
+    cfg = PlannerConfig(max_iterations=200, informed=True, gap_share=0.5, straight_first=True)
+    p = Planner(occ, "vnrrt_star", heatmap=np.ones((8, 8)), config=cfg)
     query = run.Query((1.5, 3.5), (6.5, 3.5), 0.0, (), False, None, 0.0, False)
-    for planner, hm in (("rrt_star", None), ("vnrrt_star", heat)):
-        for informed in (False, True):
-            p = Planner(occ, planner, heatmap=hm,
-                        config=PlannerConfig(max_iterations=200, informed=informed))  # fmt: skip
-            run.run(occ, query, planner=planner, setup=p.setup, seed=0)
-    p = Planner(occ, config=PlannerConfig(max_iterations=200, gap_share=0.5, straight_first=True))
-    run.run(occ, query, planner="rrt_star", setup=p.setup, seed=0)
+    run.run(occ, query, planner="vnrrt_star", setup=p.setup, seed=0)
     log.debug("planner kernels compiled")

@@ -5,17 +5,12 @@ they differ only in the :class:`Draws` (the sampler) and :class:`Params` passed 
 their stop rule. One iteration is: Sample, Nearest, Steer (step ``eta``), ObstacleFree,
 Extend (choose the cheapest collision-free parent among the near nodes), Rewire (re-parent
 near nodes through the new node, propagating the cost change to their descendants), then
-try to connect the new node to the goal point.
-
-The options (their meaning: :class:`vnrrt.planners.PlannerConfig`): **informed**
-(Gammell et al., 2014), once a solution of cost ``c_best`` exists, samples inside the
-ellipse of ``c_best`` (:func:`.samplers.any_point`) and skips a near node ``q`` with ``|q -
-start| + |q - goal| > c_best`` as parent or rewiring candidate, and a new node whose
-cost-to-come plus its straight line to the goal exceeds ``c_best``; **gaps** draw a share
-of the samples from the narrow-passage cells, found inside the run (:func:`with_gaps`);
-**refine** makes a share of the iterations local moves on the best path (:mod:`.refine`);
-**pull_parents** replaces a new node's parent by its furthest ancestor that sees it
-(:func:`pull_up`).
+try to connect the new node to the goal point. The options (:class:`vnrrt.planners.
+PlannerConfig`): **informed**, once a solution of cost ``c_best`` exists, samples inside its
+ellipse (:func:`.samplers.any_point`) and skips a near node ``q`` with ``|q - start| + |q -
+goal| > c_best`` as parent or rewiring candidate, and a new node whose cost-to-come plus its
+straight line to the goal exceeds ``c_best``; **gaps** (:func:`with_gaps`), **refine**
+(:mod:`.refine`) and **pull_parents** (:func:`pull_up`).
 
 The tree lives in preallocated arrays (:mod:`.tree`); positions are continuous ``(x, y)``
 pixels, costs are path lengths in pixels from the start. The goal, once connected, is a

@@ -1,19 +1,16 @@
-"""One timed planner run on a checked query: the run's settings and tree arrays, the compiled
-loop that grows the tree (:func:`grow_tree`) and the :class:`PlanResult` built from it.
+"""One timed planner run on a checked query: the settings and arrays runs share
+(:class:`Setup`), the compiled loop that grows the tree (:func:`grow_tree`) and the
+:class:`PlanResult` built from it. ``occ`` is the ``(H, W)`` uint8 grid indexed ``occ[y, x]``
+(nonzero = obstacle), points ``(x, y)`` pixels, times seconds on ``time.perf_counter``'s clock.
 
-Coordinates follow :mod:`vnrrt.grid`: ``occ`` is the ``(H, W)`` uint8 grid indexed
-``occ[y, x]`` (nonzero = obstacle), points are continuous ``(x, y)`` pixels, lengths pixels,
-times seconds on ``time.perf_counter``'s clock.
-
-The clock starts before the straight start-goal segment is tested (when ``straight_first``;
-a free segment that meets the stop rule is the exact optimum and ends the run, a two-node
-tree) and stops when the stop rule or a budget is met and the path and trace are taken out
-of the tree (as OMPL's ``solve()`` builds its solution path). The tree grows in one compiled
-call: chunks of :func:`vnrrt.planners.rrt_star.grow` (:data:`FIRST_CHUNK` iterations first,
-doubling up to :data:`MAX_CHUNK`), the budgets checked and the bounds' first-pass times
-taken between chunks; it returns to Python when the run is over or the tree's arrays are
-full (then enlarged, inside the clock). The arrays are allocated or emptied before the
-clock starts, as OMPL's ``setup()`` is outside its ``solve()`` times.
+The clock starts before the straight start-goal segment is tested (``straight_first``: a free
+segment that meets the stop rule is the exact optimum and ends the run) and stops when the
+stop rule or a budget is met and the path and trace are out of the tree (as OMPL's
+``solve()``). The tree grows in chunks of :func:`vnrrt.planners.rrt_star.grow`
+(:data:`FIRST_CHUNK` iterations, doubling up to :data:`MAX_CHUNK`), the budgets checked and
+the bounds' first-pass times taken between chunks, in one compiled call that returns when
+the run is over or the tree is full (enlarged inside the clock). The arrays are allocated or
+emptied before the clock starts, as OMPL's ``setup()`` is outside its ``solve()`` times.
 """
 
 from __future__ import annotations
@@ -32,8 +29,7 @@ from vnrrt.planners.clock import monotonic
 from vnrrt.planners.config import PlannerConfig
 from vnrrt.planners.result import Milestone, PlanResult
 from vnrrt.planners.rrt_star import TREE_FULL, Params
-from vnrrt.planners.samplers import Draws, Sampler
-from vnrrt.planners.seeding import rng_state
+from vnrrt.planners.samplers import Draws, Sampler, rng_state
 
 FIRST_CAPACITY = 4096  # tree nodes allocated first; doubled when full (up to the budget)
 FIRST_CHUNK, MAX_CHUNK = 64, 4096  # iterations per chunk; budgets checked between
@@ -56,57 +52,19 @@ class Query(NamedTuple):
     fallback_uniform: bool
 
 
-class Tree:
-    """The arrays of a growing run (:mod:`.tree`): nodes, scratch buffers, counters, trace;
-    ``flat``: the same as plain tuples, as :func:`grow_tree` takes them (numba types a call's
-    plain tuples of arrays about 3x faster than named tuples)."""
-
-    def __init__(self, capacity: int, shape: tuple[int, int], bucket: float, trace: int):
-        self.tree = nodes.new_tree(capacity, shape, bucket)
-        self.scratch = nodes.new_scratch(capacity)
-        self.counters = nodes.new_counters()
-        self.trace = nodes.Trace(np.empty(trace, np.int64), np.empty(trace))
-        self._flatten()
-
-    def _flatten(self) -> None:
-        self.flat = tuple(self.tree), tuple(self.scratch), tuple(self.counters), tuple(self.trace)
-
-    def enlarge(self, max_iterations: int) -> None:
-        """Double a full tree's room, up to the budget's (root, goal and a node per
-        iteration), the tree kept."""
-        capacity = len(self.tree.cost)
-        if capacity >= max_iterations + 2:
-            raise RuntimeError(f"tree of {capacity} nodes full before the budget")
-        capacity = min(2 * capacity, max_iterations + 2)
-        self.tree = nodes.enlarge(self.tree, capacity)
-        self.scratch = nodes.new_scratch(capacity)
-        self._flatten()
-
-    def reset(self) -> None:
-        """Empty the tree, its arrays kept (a node's fields are written when it is added)."""
-        for count in self.counters:
-            count[0] = 0
-        self.counters.goal[0] = -1
-        self.tree.head.fill(-1)
-
-
 class Setup:
-    """What every run of one planner on one map shares (as OMPL's ``setup()``), made when
-    a run first needs it: the budgets (:attr:`budget`: fixed, or scaled with the map's free
-    cells by the budget rule, :meth:`PlannerConfig.budgets`) and, from the first tree run on
-    (a straight answer needs none), the core's settings (:attr:`params`,
-    :class:`~vnrrt.planners.rrt_star.Params`, the query's start and goal left at 0), the
-    sampler as the core reads it (:attr:`draws`) and the tree's arrays (:meth:`fresh`; one
-    run at a time)."""
+    """What every run of one planner on one map shares (as OMPL's ``setup()``), each made
+    when a run first needs it (a straight answer needs only the budget): the budgets, the
+    core's settings, the sampler as the core reads it and the tree's arrays (one run at a
+    time)."""
 
     def __init__(self, occ: np.ndarray, cfg: PlannerConfig, sampler: Sampler):
         self.occ, self.cfg, self.sampler = occ, cfg, sampler
-        self._tree: Tree | None = None
+        self._tree: nodes.Arrays | None = None
 
     @functools.cached_property
     def budget(self) -> tuple[int, float]:
-        """``(max_iterations, max_seconds)`` on this map (free cells counted only when the
-        config scales a budget with them)."""
+        """``(max_iterations, max_seconds)`` on this map (:meth:`PlannerConfig.budgets`)."""
         free = self.occ.size - np.count_nonzero(self.occ) if self.cfg.scales_budgets else 0
         return self.cfg.budgets(free)
 
@@ -118,7 +76,7 @@ class Setup:
 
     @functools.cached_property
     def params(self) -> Params:
-        """The core's settings (the config's and the map's gamma)."""
+        """The core's settings (the config's and the map's gamma; start and goal 0)."""
         cfg = self.cfg
         return Params(
             eta=float(cfg.eta),
@@ -136,25 +94,28 @@ class Setup:
 
     @functools.cached_property
     def draws(self) -> tuple:
-        """The sampler and the gap sampler as the core reads them (a plain :class:`Draws`;
-        the gap cells, when used, found in the run)."""
+        """The sampler and the gap sampler as the core reads them (a plain :class:`Draws`)."""
         cfg = self.cfg
-        return tuple(self.sampler.draws(cfg.gap_share, cfg.gap_width, cfg.gap_after))
+        draws = self.sampler.draws(
+            gap_share=cfg.gap_share, gap_width=cfg.gap_width, gap_after=cfg.gap_after
+        )
+        return tuple(draws)
 
-    def fresh(self) -> Tree:
+    def fresh(self) -> nodes.Arrays:
         """An empty tree: allocated (:data:`FIRST_CAPACITY` nodes, or the budget's) by the
-        first run, emptied by the next ones (kept as large as it grew)."""
+        first run, emptied by the next ones."""
         if self._tree is None:
             capacity = min(self.budget[0] + 2, FIRST_CAPACITY)
-            self._tree = Tree(capacity, self.occ.shape, self.bucket, self.cfg.trace_capacity)
+            self._tree = nodes.Arrays(
+                capacity, self.occ.shape, self.bucket, self.cfg.trace_capacity
+            )
         self._tree.reset()
         return self._tree
 
 
 def gamma(occ: np.ndarray, cfg: PlannerConfig) -> float:
     """The shrinking-radius constant: ``cfg.gamma_factor`` x (``cfg.gamma``, or the RRT*
-    bound ``2 (1 + 1/d)^(1/d) (free area / unit-ball area)^(1/d)``, d = 2, of the map
-    ``occ``, its free area in cells)."""
+    bound ``2 sqrt(1.5) sqrt(F / pi)`` of the map ``occ`` of F free cells)."""
     factor = float(cfg.gamma_factor)
     if cfg.gamma is not None:
         return factor * float(cfg.gamma)
@@ -164,7 +125,7 @@ def gamma(occ: np.ndarray, cfg: PlannerConfig) -> float:
 
 def run(occ: np.ndarray, query: Query, *, planner: str, setup: Setup, seed) -> PlanResult:
     """The timed run of ``query`` (module doc) with ``setup``'s settings and arrays, sampling
-    from the xoshiro256** generator seeded by ``seed`` (:func:`.seeding.rng_state`)."""
+    from the xoshiro256** generator seeded by ``seed`` (:func:`.samplers.rng_state`)."""
     (sx, sy), (gx, gy) = query.start, query.goal
     target, d, spent, cfg = query.target, -1.0, 0.0, setup.cfg
     if cfg.straight_first:
@@ -191,8 +152,11 @@ def run(occ: np.ndarray, query: Query, *, planner: str, setup: Setup, seed) -> P
         tree.enlarge(max_iterations)
     elapsed = time.perf_counter() - t0
     reached = dict(zip(stops.tolist(), zip(times.tolist(), iters.tolist()), strict=True))
-    return result(tree, planner, query, reason=REASONS[code], reached=reached,
-                  elapsed=elapsed, arrays=arrays, budget=setup.budget)  # fmt: skip
+    c, t = tree.counters, tree.tree
+    counts = (int(c.iters[0]), int(c.nodes[0]), int(c.checks[0]))
+    return result(planner, query, setup.budget, reason=REASONS[code], reached=reached,
+                  elapsed=elapsed, counts=counts, arrays=arrays,
+                  tree=(t.pts, t.links[:, nodes.PARENT]))  # fmt: skip
 
 
 def stop_bounds(query: Query) -> np.ndarray:
@@ -205,19 +169,17 @@ def stop_bounds(query: Query) -> np.ndarray:
 @njit(cache=True)
 def grow_tree(occ, tree, scratch, counters, trace, rng, draws, stops, p, first, limits, state,
               times, iters):  # fmt: skip
-    """Plant the tree (when ``state[2]`` is 1) and grow it until the run is over; then its
-    path, segment lengths, trace iterations and costs (:func:`vnrrt.planners.tree.finish`).
+    """Plant the tree (when ``state[2]`` is 1) and grow it until the run is over; returns
+    ``(code, path, segs, trace_iters, trace_costs)`` (:func:`vnrrt.planners.tree.finish`;
+    empty when ``code`` is :data:`~vnrrt.planners.rrt_star.TREE_FULL`: enlarge, call again).
 
-    ``tree``, ``scratch``, ``counters``, ``trace`` (:attr:`Tree.flat`), ``draws`` and ``p``
-    (``first``: those of planting) are plain tuples (:class:`Draws`, :class:`Params`);
+    ``tree``, ``scratch``, ``counters``, ``trace`` (:attr:`.tree.Arrays.flat`), ``draws`` and
+    ``p`` (``first``: those of planting) are plain tuples (:class:`Draws`, :class:`Params`);
     ``stops`` (M,) decreasing cost bounds; ``limits`` ``(target, max_iterations,
     max_seconds, t0)`` (target ``inf``: the first solution; ``t0``: the run's start on the
     clock, seconds); ``state`` (3,) int64 kept across calls: next chunk size, bounds passed,
     plant first; ``times`` (M,) float64 and ``iters`` (M,) int64: when each bound was first
-    passed (NaN / -1: never). Returns ``(code, path, segs, trace_iters, trace_costs)``, the
-    code :data:`SOLVED`, :data:`MAX_ITERATIONS`, :data:`MAX_SECONDS` or
-    :data:`~vnrrt.planners.rrt_star.TREE_FULL` (the arrays then empty: the caller enlarges
-    the tree and calls again).
+    passed (NaN / -1: never).
     """
     t, c, tr = nodes.Tree(*tree), nodes.Counters(*counters), nodes.Trace(*trace)
     scratch, draws, p = nodes.Scratch(*scratch), Draws(*draws), Params(*p)
@@ -252,36 +214,30 @@ def grow_tree(occ, tree, scratch, counters, trace, rng, draws, stops, p, first, 
         state[0] = min(2 * state[0], MAX_CHUNK)
 
 
-def result(
-    tree: Tree,
-    planner: str,
-    query: Query,
-    *,
-    reason: str,
-    reached: dict[float, tuple[float, int]],
-    elapsed: float,
-    arrays: list,
-    budget: tuple[int, float],
-) -> PlanResult:
-    """The :class:`PlanResult` of a finished run; ``reached[bound] = (seconds, iteration)``;
-    ``arrays``: its path, segment lengths, trace iterations and costs (:func:`grow_tree`);
-    ``budget``: its ``(max_iterations, max_seconds)``."""
-    c, t = tree.counters, tree.tree
-    n, g, k = int(c.nodes[0]), int(c.goal[0]), int(c.trace_len[0])
+def result(planner: str, query: Query, budget: tuple[int, float], *, reason: str,
+           reached: dict[float, tuple[float, int]], elapsed: float, counts: tuple[int, int, int],
+           arrays, tree) -> PlanResult:  # fmt: skip
+    """The :class:`PlanResult` of a finished run with ``budget`` ``(max_iterations,
+    max_seconds)``: ``reached[bound] = (seconds, iteration)`` for ``inf`` and each of
+    ``query.bounds``; ``counts`` its ``(iterations, tree nodes N, collision checks)``;
+    ``arrays`` its path, segment lengths, trace iterations and costs (:func:`grow_tree`);
+    ``tree`` the node positions ``(>= N, 2)`` and parents ``(>= N,)``, copied when kept."""
+    iterations, n, checks = counts
     path, segs, trace_iterations, trace_costs = arrays
     first_time, first_iteration = reached[math.inf]
+    keep = query.keep_tree
     return PlanResult(
         planner=planner,
         success=reason == "solved",
         stop_reason=reason,
         path=path,
-        cost=float(np.add.reduce(segs)) if g >= 0 else math.inf,  # = polyline_length(path)
-        iterations=int(c.iters[0]),
+        cost=float(np.add.reduce(segs)) if len(path) else math.inf,  # = polyline_length(path)
+        iterations=iterations,
         tree_size=n,
-        collision_checks=int(c.checks[0]),
+        collision_checks=checks,
         time_to_first=first_time,
         time_to_stop=elapsed,
-        first_cost=float(trace_costs[0]) if k else math.inf,
+        first_cost=float(trace_costs[0]) if len(trace_costs) else math.inf,
         first_iteration=first_iteration,
         trace_iterations=trace_iterations,
         trace_costs=trace_costs,
@@ -291,8 +247,8 @@ def result(
         fallback_uniform=query.fallback_uniform,
         setup_time=query.setup_time,
         budget=budget,
-        tree_points=t.pts[:n].copy() if query.keep_tree else None,
-        tree_parents=t.links[:n, nodes.PARENT].copy() if query.keep_tree else None,
+        tree_points=tree[0][:n].copy() if keep else None,
+        tree_parents=tree[1][:n].copy() if keep else None,
     )
 
 
@@ -302,30 +258,8 @@ def straight_result(planner: str, d: float, found: float, query: Query,
     straight segment of length ``d`` from start to goal: the tree is the root and the goal
     joined to it (one segment test). The cost is ``d``, equal to the polyline length of the
     path (both are libm's ``hypot``)."""
-    path, keep, bounds = np.array((query.start, query.goal)), query.keep_tree, query.bounds
-    return PlanResult(
-        planner=planner,
-        success=True,
-        stop_reason="solved",
-        path=path,
-        cost=d,
-        iterations=0,
-        tree_size=2,
-        collision_checks=1,
-        time_to_first=found,
-        time_to_stop=found,
-        first_cost=d,
-        first_iteration=0,
-        trace_iterations=np.zeros(1, np.int64),
-        trace_costs=np.array((d,)),
-        reference_length=query.reference_length,
-        target_cost=query.target,
-        milestones=tuple(Milestone(b, found, 0) if d <= b else Milestone(b) for b in bounds)
-        if bounds
-        else (),
-        fallback_uniform=query.fallback_uniform,
-        setup_time=query.setup_time,
-        budget=budget,
-        tree_points=path.copy() if keep else None,
-        tree_parents=np.array((-1, 0), np.int64) if keep else None,
-    )
+    path, cost = np.array((query.start, query.goal)), np.array((d,))
+    reached = {b: (found, 0) if d <= b else (math.nan, -1) for b in (math.inf, *query.bounds)}
+    return result(planner, query, budget, reason="solved", reached=reached, elapsed=found,
+                  counts=(0, 2, 1), arrays=(path, cost, np.zeros(1, np.int64), cost),
+                  tree=(path, np.array((-1, 0), np.int64)))  # fmt: skip

@@ -13,12 +13,11 @@ and the gap sampler (a share of the samples from the narrow-passage cells of :mo
 If no positive weight is left, the sampler falls back to uniform (no heatmap draws) and sets
 ``fallback_uniform``. Huge or tiny weights are scaled by a power of two before they are summed
 (the draws stay those of the given weights). Randomness comes from a xoshiro256** generator
-seeded as :class:`numpy.random.SeedSequence` seeds it (:func:`.seeding.rng_state`).
+seeded by :class:`numpy.random.SeedSequence` (:func:`rng_state`).
 """
 
 from __future__ import annotations
 
-import functools
 import math
 from dataclasses import dataclass
 from typing import NamedTuple
@@ -27,7 +26,6 @@ import numpy as np
 from numba import njit
 
 from vnrrt.grid import GridError
-from vnrrt.planners.seeding import rng_state
 
 _INV_2_53 = 1.0 / 9007199254740992.0
 NO_CELLS = np.zeros(1, np.int64)  # the gap cells of a sampler without (or not yet with) any
@@ -48,6 +46,16 @@ class Draws(NamedTuple):
     gap_after: int = 0
     gap_cells: np.ndarray = NO_CELLS
     n_gaps: int = 0
+
+
+def rng_state(seed) -> np.ndarray:
+    """Fresh xoshiro256** state ``(4,)`` uint64 from ``seed`` (int >= 0 or tuple of them):
+    ``SeedSequence(seed).generate_state(4, np.uint64)``, the all-zero state (the one invalid
+    xoshiro state) made ``[1, 0, 0, 0]``."""
+    state = np.random.SeedSequence(seed).generate_state(4, dtype=np.uint64)
+    if not state.any():
+        state[0] = 1
+    return state
 
 
 @njit(cache=True, inline="always")
@@ -93,7 +101,7 @@ class Sampler:
     fallback_uniform: bool = False
     tau: float | None = None
 
-    def draws(self, gap_share=0.0, gap_width=8, gap_after=0, cells=None) -> Draws:
+    def draws(self, *, gap_share=0.0, gap_width=8, gap_after=0, cells=None) -> Draws:
         """This sampler as the compiled draw reads it, with the gap sampler's settings and
         flat ``cells`` (None: pending, found by the run when ``gap_share > 0``). Without
         weights (uniform, or after a fallback) no heatmap draw is made (``mix`` 0)."""
@@ -106,19 +114,12 @@ class Sampler:
 
 
 def uniform_sampler(shape: tuple[int, int]) -> Sampler:
-    """Uniform sampler over the ``(H, W)`` map (one per shape: it holds nothing else)."""
-    return _uniform((int(shape[0]), int(shape[1])))
-
-
-@functools.lru_cache(maxsize=64)
-def _uniform(shape: tuple[int, int]) -> Sampler:
-    no_weights = np.zeros(0)
-    no_weights.flags.writeable = False
-    return Sampler("uniform", 0.0, no_weights, -1, shape)
+    """Uniform sampler over the ``(H, W)`` map."""
+    return Sampler("uniform", 0.0, np.zeros(0), -1, (int(shape[0]), int(shape[1])))
 
 
 def heatmap_sampler(
-    heatmap: np.ndarray, shape: tuple[int, int], mix: float = 0.5, tau: float | None = None
+    heatmap: np.ndarray, shape: tuple[int, int], *, mix: float = 0.5, tau: float | None = None
 ) -> Sampler:
     """Heatmap sampler (``tau=None``) or masked sampler (weights below ``tau`` zeroed).
 
@@ -200,12 +201,10 @@ def in_ellipse(x, y, sx, sy, gx, gy, c_best):
 def ellipse_uniform(s, h, w, sx, sy, gx, gy, c_best):
     """A uniform point of the ellipse (foci start and goal, major axis ``c_best``) inside the
     map ``[0, W) x [0, H)``, by rejection from the smaller of two regions that hold it: the
-    ellipse itself (points outside the map rejected) or the map part of the ellipse's
-    axis-aligned bounding box (points outside the ellipse rejected). The start-goal segment
-    lies in both the map and the ellipse, so the acceptance rate stays high (0.77 the lowest
-    over 3,000 random map sizes, endpoints and costs); after :data:`INFORMED_TRIES`
-    rejections (never seen) a uniform point of that segment is returned, so a draw is never
-    outside the ellipse or the map."""
+    ellipse (points outside the map rejected) or the map part of its bounding box (points
+    outside the ellipse rejected); acceptance is at least 0.77 over 3,000 random map sizes,
+    endpoints and costs. After :data:`INFORMED_TRIES` rejections (never seen) a uniform
+    point of the start-goal segment (in both) is returned."""
     c_min = math.hypot(gx - sx, gy - sy)
     a = 0.5 * c_best
     b = 0.5 * math.sqrt(max(c_best * c_best - c_min * c_min, 0.0))
@@ -237,12 +236,10 @@ def ellipse_uniform(s, h, w, sx, sy, gx, gy, c_best):
 def any_point(s, h, w, d, ellipse):
     """One sample ``(x, y)`` (pixels) of the sampler ``d`` (a :class:`Draws`), ``s`` the rng
     state: with probability ``d.gap_share`` (when gap cells exist) a gap sampler's draw, else
-    with probability ``d.mix`` a heatmap draw, else a uniform point of the map. ``ellipse``
-    is ``(informed, sx, sy, gx, gy, c_best)``: when informed, a gap or heatmap draw is
-    conditioned on the ellipse of ``c_best`` (rejection: at most :data:`HEATMAP_TRIES`
-    draws; when all fall outside, there is next to no mass in the ellipse and the sample is
-    uniform there instead) and a uniform point is one of the ellipse inside the map
-    (:func:`ellipse_uniform`). A share or mix of 0 spends no random number on its choice."""
+    with probability ``d.mix`` a heatmap draw, else a uniform point of the map (a share or
+    mix of 0 spends no random number). ``ellipse`` is ``(informed, sx, sy, gx, gy, c_best)``:
+    when informed, a gap or heatmap draw is rejected outside the ellipse of ``c_best`` (at
+    most :data:`HEATMAP_TRIES` times, then a uniform point of it: :func:`ellipse_uniform`)."""
     informed, sx, sy, gx, gy, c_best = ellipse
     gap = d.gap_share > 0.0 and d.n_gaps > 0 and next_double(s) < d.gap_share
     if not gap and not (d.mix > 0.0 and next_double(s) < d.mix):
@@ -264,7 +261,7 @@ def _draw(s, count, h, w, d, ellipse):
     return out
 
 
-def draw(sampler: Sampler, n: int, seed=0, ellipse=None, gaps=None) -> np.ndarray:
+def draw(sampler: Sampler, n: int, *, seed=0, ellipse=None, gaps=None) -> np.ndarray:
     """``n`` samples ``(n, 2)`` float64 (x, y) in pixels from ``sampler`` (for tests, plots);
     ``ellipse=(start, goal, c_best)`` draws the informed samples of a run whose best solution
     costs ``c_best``; ``gaps=(share, cells)`` mixes in the gap sampler's draws as a planner
@@ -272,6 +269,6 @@ def draw(sampler: Sampler, n: int, seed=0, ellipse=None, gaps=None) -> np.ndarra
     gap_cells`)."""
     (sx, sy), (gx, gy), c_best = ellipse if ellipse is not None else ((0, 0), (0, 0), 0.0)
     share, cells = (gaps[0], np.asarray(gaps[1], np.int64)) if gaps is not None else (0.0, None)
-    d = sampler.draws(share, cells=cells)
+    d = sampler.draws(gap_share=share, cells=cells)
     ends = (ellipse is not None, float(sx), float(sy), float(gx), float(gy), float(c_best))
     return _draw(rng_state(seed), int(n), *sampler.shape, d, ends)

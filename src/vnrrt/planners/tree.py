@@ -66,43 +66,52 @@ class Trace(NamedTuple):
     costs: np.ndarray
 
 
-def new_tree(capacity: int, shape: tuple[int, int], bucket: float) -> Tree:
-    """Empty node arrays for ``capacity`` nodes on an ``(H, W)`` map."""
-    c = int(capacity)
-    return Tree(
-        np.empty((c, 2)),
-        np.empty(c),
-        np.empty((c, 4), np.int64),
-        np.empty(c, np.int64),
-        np.empty(c),
-        spatial.new_buckets(shape, bucket),
-    )
+class Arrays:
+    """The arrays of one run for ``capacity`` nodes on an ``(H, W)`` map: :attr:`tree`,
+    :attr:`scratch`, :attr:`counters` (views of one array), :attr:`trace` (``trace``
+    points); :attr:`flat`: the same as plain tuples, as the compiled loop takes them (numba
+    types a call's plain tuples of arrays about 3x faster than named tuples). Empty once
+    :meth:`reset`."""
 
+    def __init__(self, capacity: int, shape: tuple[int, int], bucket: float, trace: int):
+        c = int(capacity)
+        self.tree = Tree(
+            np.empty((c, 2)),
+            np.empty(c),
+            np.empty((c, 4), np.int64),
+            np.empty(c, np.int64),
+            np.empty(c),
+            spatial.new_buckets(shape, bucket),
+        )
+        buf = np.zeros(len(Counters._fields), np.int64)
+        self.counters = Counters(*(buf[i : i + 1] for i in range(len(buf))))
+        self.trace = Trace(np.empty(trace, np.int64), np.empty(trace))
+        self._new_scratch(c)
 
-def new_scratch(capacity: int) -> Scratch:
-    c = int(capacity)
-    return Scratch(
-        np.empty(c, np.int64), np.empty(c), np.empty(c), np.empty(c, np.int8), np.empty(c, np.int64)
-    )
+    def _new_scratch(self, c: int) -> None:
+        kinds = (np.int64, np.float64, np.float64, np.int8, np.int64)  # the fields' dtypes
+        self.scratch = Scratch(*(np.empty(c, kind) for kind in kinds))
+        self.flat = tuple(self.tree), tuple(self.scratch), tuple(self.counters), tuple(self.trace)
 
+    def enlarge(self, max_iterations: int) -> None:
+        """Double a full tree's room, up to the budget's (root, goal and a node per
+        iteration), the tree kept: memory grows with the work done."""
+        n = len(self.tree.cost)
+        if n >= max_iterations + 2:
+            raise RuntimeError(f"tree of {n} nodes full before the budget")
+        c = min(2 * n, max_iterations + 2)
+        grown = [np.empty((c, *arr.shape[1:]), arr.dtype) for arr in self.tree[:-1]]
+        for new, arr in zip(grown, self.tree[:-1], strict=True):
+            new[:n] = arr
+        self.tree = Tree(*grown, self.tree.head)
+        self._new_scratch(c)
 
-def new_counters() -> Counters:
-    """Zero counts (views of one array), no goal node."""
-    buf = np.zeros(len(Counters._fields), np.int64)
-    c = Counters(*(buf[i : i + 1] for i in range(len(buf))))
-    c.goal[0] = -1
-    return c
-
-
-def enlarge(tree: Tree, capacity: int) -> Tree:
-    """The same tree in arrays for ``capacity`` nodes (memory grows with the work done)."""
-    n = len(tree.cost)
-    out = []
-    for arr in tree[:-1]:
-        new = np.empty((int(capacity), *arr.shape[1:]), arr.dtype)
-        new[:n] = arr
-        out.append(new)
-    return Tree(*out, tree.head)
+    def reset(self) -> None:
+        """Empty the tree, its arrays kept (a node's fields are written when it is added)."""
+        for count in self.counters:
+            count[0] = 0
+        self.counters.goal[0] = -1
+        self.tree.head.fill(-1)
 
 
 @njit(cache=True)
