@@ -31,7 +31,7 @@ def seed_claims_section(summary: dict) -> list[str]:
             "seeds whose sampler tests the claim"]  # fmt: skip
     lines = ["## The random-map claims over training seeds", "",
              f"The paper's quoted claims on random maps, read at the largest budget ({steps:,} "
-             f"steps, the pipeline's own training) over the networks of training seeds {seeds}: "
+             f"steps) over the networks of training seeds {seeds}: "
              "pooled, the interval resamples the seeds, then base maps, instances and trials, so "
              "it includes the training variance; beside it, each seed's network pair alone. "
              "Planning time, our estimand (geometric mean over instances of median(baseline) / "
