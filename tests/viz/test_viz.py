@@ -318,7 +318,7 @@ def test_budget_figure_lines_per_planner_and_stop_with_bands_and_masses():
         "nrrtnet: near the interior vertices",
         "nrrtnet: near the path",
     ]
-    assert "80% CI" in fig._suptitle.get_text() and "train.seed 1" in fig._suptitle.get_text()
+    assert "80% CI" in fig._suptitle.get_text() and "training seeds 1" in fig._suptitle.get_text()
 
 
 def test_validation_figure_rows_and_colour_bars():

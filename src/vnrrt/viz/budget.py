@@ -19,12 +19,17 @@ METRIC_NAMES = {"time_to_stop": "time", "iterations": "iterations"}
 
 
 def _band(ax, x, cells: list[dict], name: str, **style) -> None:
-    """One line (``speedup``) with its CI band (``ci_low``..``ci_high``; None: no band)."""
+    """One line (``speedup``) with its CI band (``ci_low``..``ci_high``; None: no band) and,
+    pooled over training seeds, each seed's own value as a small dot (``per_seed``)."""
     y = [c["speedup"] for c in cells]
     lo = [np.nan if c["ci_low"] is None else c["ci_low"] for c in cells]
     hi = [np.nan if c["ci_high"] is None else c["ci_high"] for c in cells]
     (line,) = ax.plot(x, y, marker="o", ms=4, label=name, **style)
     ax.fill_between(x, lo, hi, color=line.get_color(), alpha=0.18, lw=0)
+    seeds = [(xi, v) for xi, c in zip(x, cells, strict=True)
+             for v in (c.get("per_seed") or {}).values()]  # fmt: skip
+    if seeds:
+        ax.scatter(*zip(*seeds, strict=True), s=6, color=line.get_color(), alpha=0.6, lw=0)
 
 
 def _speedup_panel(ax, summary: dict, stop: str, metric: str) -> None:
@@ -89,8 +94,10 @@ def budget_figure(summary: dict, metric: str):
         ax.legend(fontsize=7)
     axes[0, 0].set_ylabel(f"speed-up ({METRIC_NAMES[metric]})")
     axes[1, 0].set_ylabel(f"ratio ({METRIC_NAMES[metric]})")
+    seeds = ", ".join(str(v) for v in s.get("seeds", [s["train_seed"]]))
+    dots = "; dots: each seed's" if len(s.get("seeds", [])) > 1 else ""
     fig.suptitle(f"The networks over a training budget: {METRIC_NAMES[metric]} "
-                 f"(bands: {level_name(s['level'])} CI; train.seed {s['train_seed']})",
+                 f"(bands: {level_name(s['level'])} CI{dots}; training seeds {seeds})",
                  fontsize=10)  # fmt: skip
     fig.tight_layout()
     return fig
