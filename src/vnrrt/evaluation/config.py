@@ -18,6 +18,8 @@ from vnrrt.evaluation.keys import MASK_VARIANTS, ConfigKey
 from vnrrt.evaluation.oracles import ORACLE_KINDS
 from vnrrt.names import PLANNERS, mask_taus
 
+BLEND_IDEA = "blend"  # the family of the path-vertex blend (oracle.blend_weights)
+HEATMAP_PLANNERS = tuple(p for p in PLANNERS if p != "rrt_star")
 REGIME_RADIUS_MODES = ("shrinking", "fixed1", "fixed2")  # fixedK: a fixed near radius K x eta
 
 
@@ -156,6 +158,7 @@ class OracleConfig:
     (:mod:`vnrrt.studies.sampling_ideas`)."""
 
     families: dict[str, list[str]]
+    planners: dict[str, str]  # idea -> the planner sampling its oracles (others: vnrrt_star)
     sigmas: list[float]
     mixes: list[float]
     blend_weights: list[float]
@@ -167,6 +170,11 @@ class OracleConfig:
     trials: int
     parts: list[int]
 
+    def planner_of(self, idea: str) -> str:
+        """The planner that samples family ``idea``'s oracles (``oracle.planners``;
+        ``vnrrt_star`` where it names none)."""
+        return self.planners.get(idea, "vnrrt_star")
+
     def validate(self) -> None:
         check(set(self.families) >= {"path", "vertex"}, "oracle.families", list(self.families),
               "needs the path and vertex ideas")  # fmt: skip
@@ -174,6 +182,18 @@ class OracleConfig:
             bad = sorted(set(kinds) - set(ORACLE_KINDS))
             ok = bool(kinds) and not bad
             check(ok, f"oracle.families.{idea}", kinds, f"known: {ORACLE_KINDS}")
+        ideas = {*self.families, BLEND_IDEA}
+        for idea, planner in self.planners.items():
+            check(idea in ideas, f"oracle.planners.{idea}", planner,
+                  f"names no family of {sorted(ideas)}")  # fmt: skip
+            ok = planner in HEATMAP_PLANNERS
+            check(ok, f"oracle.planners.{idea}", planner, f"known: {HEATMAP_PLANNERS}")
+        seen: dict = {}
+        for idea, kinds in self.families.items():
+            for kind in kinds:
+                other = seen.setdefault((self.planner_of(idea), kind), idea)
+                check(other == idea, f"oracle.families.{idea}", kinds,
+                      f"{kind} is in {other} too, sampled by the same planner")  # fmt: skip
         ok = bool(self.sigmas) and all(s >= 0 for s in self.sigmas)
         check(ok, "oracle.sigmas", self.sigmas, "every blur must be >= 0 px")
         ok = bool(self.mixes) and all(0 < m <= 1 for m in self.mixes)

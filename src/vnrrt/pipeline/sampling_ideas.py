@@ -53,7 +53,7 @@ class Study:
     regime: RegimeConfig | None
     seed: int
     protocol: dict
-    rules: Rules | None = None  # eps and max_iterations: the merged tables' checks
+    rules: Rules | None = None  # eps, max_iterations (the merged tables' checks), tau (M-VNRRT*)
 
     def design(self):
         """What the merged tables' rows must keep (:mod:`vnrrt.evaluation.invariants`)."""
@@ -81,8 +81,8 @@ class Study:
         from vnrrt.studies.sampling_ideas.design import oracle_counts, selection_keys
 
         kinds, sel, _ = self.instances()
-        return trial_jobs(kinds, selection_keys(self.oracle), oracle_counts(self.oracle),
-                          instances=sel)  # fmt: skip
+        keys = selection_keys(self.oracle, self.rules.tau)
+        return trial_jobs(kinds, keys, oracle_counts(self.oracle), instances=sel)
 
     def envelopes(self) -> tuple[dict, dict]:
         """``(speed-ups, envelopes)`` of the merged selection
@@ -93,7 +93,7 @@ class Study:
 
         rows = sum(j.count for j in self.selection_jobs())
         table = merge_parts(self.paths.oracle, self.oracle.parts, rows, self.design())
-        speedups = member_speedups(table, family_members(self.oracle))
+        speedups = member_speedups(table, family_members(self.oracle, self.rules.tau))
         return speedups, select(speedups)
 
     def evaluation_jobs(self, envelopes: dict) -> list:
@@ -232,7 +232,7 @@ def ideas_summary(tables: dict, settings: dict, free: dict[int, int] | None = No
     shown |= {"zero_obstacles": st.ev.zero_obstacles, "selection_share": st.oracle.selection_share}
     predict = read_json(st.paths.predict_metrics)["networks"]
     study = {"oracle": st.oracle, "regime": st.regime, "ev": st.ev, "protocol": st.protocol,
-             "targets": {n: m["target"] for n, m in predict.items()}}  # fmt: skip
+             "targets": {n: m["target"] for n, m in predict.items()}, "tau": rules.tau}  # fmt: skip
     return as_json(analyze_study(tables, study, pairs, shown, free))
 
 

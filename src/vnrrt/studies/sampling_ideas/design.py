@@ -8,7 +8,9 @@
   every oracle family (:func:`family_members`): each target of ``oracle.families`` at each blur
   of ``oracle.sigmas`` and heatmap-draw probability of ``oracle.mixes``, and the path-vertex
   blend (:func:`vnrrt.evaluation.oracles.blend`) at each ``oracle.blend_weights`` x blur x
-  mix, all through the heatmap sampler; every stop rule, ``oracle.trials`` trials each. Each
+  mix, each sampled by its family's planner (``oracle.planners``: NRRT* the path oracles,
+  M-VNRRT* at ``planner.tau`` the masked-vertex ones, a perfect M-VNRRT* heatmap; VNRRT* the
+  others); every stop rule, ``oracle.trials`` trials each. Each
   family's best member per stop rule (the most RRT* iterations saved,
   :func:`vnrrt.studies.sampling_ideas.selection.select`) is its **envelope**.
 * **Evaluation** (stage ``regime@<k>``): on the evaluation instances, in the protocol's cell
@@ -27,15 +29,15 @@ import math
 
 import numpy as np
 
-from vnrrt.evaluation.config import Configurations, OracleConfig, RegimeConfig
+from vnrrt.evaluation.config import BLEND_IDEA, Configurations, OracleConfig, RegimeConfig
 from vnrrt.evaluation.keys import ConfigKey
 from vnrrt.evaluation.oracles import BLEND, OracleSource
 from vnrrt.evaluation.protocol import STOPS
 from vnrrt.studies.sampling_ideas.distinct import cell_key
 
 PROTOCOL = "protocol"  # the regime cell of the protocol's own planner settings
-IDEA_PLANNER = {"path": "nrrt_star"}  # path oracles are NRRT*'s idea; the others VNRRT*'s
 QUALITY_IDEAS = ("path", "vertex")  # the families of the quality curve
+MASKED_IDEA = "masked_vertex"  # the family a perfect M-VNRRT* heatmap is (oracle.planners)
 
 
 def split_instances(
@@ -55,21 +57,25 @@ def split_instances(
     return sel, ev
 
 
-def member(idea: str, source: OracleSource, mix: float) -> ConfigKey:
-    """The configuration sampling oracle ``source`` with heatmap-draw probability ``mix``."""
-    return ConfigKey(IDEA_PLANNER.get(idea, "vnrrt_star"), mix=mix).with_source(source.text)
+def member(planner: str, source: OracleSource, mix: float, tau: float) -> ConfigKey:
+    """The configuration in which ``planner`` samples oracle ``source`` with heatmap-draw
+    probability ``mix``; M-VNRRT* masks it below ``tau`` (an oracle's maximum is 1, so tau
+    reads as on a perfect network's probabilities, and as the ``max`` mask variant)."""
+    key = ConfigKey(planner, tau=float(tau) if planner == "m_vnrrt_star" else None, mix=mix)
+    return key.with_source(source.text)
 
 
-def family_members(oc: OracleConfig) -> dict[str, list[ConfigKey]]:
+def family_members(oc: OracleConfig, tau: float) -> dict[str, list[ConfigKey]]:
     """``{idea: members}``: every family of ``oracle.families`` and the ``blend`` (module
-    doc), in a fixed order."""
+    doc), in a fixed order, each sampled by its planner (``oracle.planners``; ``tau``:
+    ``planner.tau``, M-VNRRT*'s threshold)."""
     out = {}
     for idea, kinds in oc.families.items():
-        out[idea] = [
-            member(idea, OracleSource(k, s), m) for k in kinds for s in oc.sigmas for m in oc.mixes
-        ]
-    out["blend"] = [
-        member("blend", OracleSource(BLEND, s, w=w), m)
+        p, grid = oc.planner_of(idea), [(s, m) for s in oc.sigmas for m in oc.mixes]
+        out[idea] = [member(p, OracleSource(k, s), m, tau) for k in kinds for s, m in grid]
+    p = oc.planner_of(BLEND_IDEA)
+    out[BLEND_IDEA] = [
+        member(p, OracleSource(BLEND, s, w=w), m, tau)
         for w in oc.blend_weights
         for s in oc.sigmas
         for m in oc.mixes
@@ -77,23 +83,24 @@ def family_members(oc: OracleConfig) -> dict[str, list[ConfigKey]]:
     return out
 
 
-def selection_keys(oc: OracleConfig) -> list[ConfigKey]:
-    """RRT* and every family member (module doc), each once."""
+def selection_keys(oc: OracleConfig, tau: float) -> list[ConfigKey]:
+    """RRT* and every family member (module doc; ``tau``: ``planner.tau``), each once."""
     keys = [ConfigKey("rrt_star")]
-    for members in family_members(oc).values():
+    for members in family_members(oc, tau).values():
         keys += members
     return list(dict.fromkeys(keys))
 
 
-def idea_of(key: ConfigKey, families: dict[str, list[str]]) -> str | None:
-    """The family a configuration's oracle belongs to (``blend`` for the blend; None for
-    networks and RRT*)."""
+def idea_of(key: ConfigKey, oc: OracleConfig) -> str | None:
+    """The family a configuration's oracle belongs to: the one holding its oracle kind and
+    sampled by its planner (``blend`` for the blend; None for networks and RRT*)."""
     if not key.named_source or not key.source.startswith("oracle_"):
         return None
     kind = OracleSource.parse(key.source).kind
     if kind == BLEND:
-        return "blend"
-    return next((idea for idea, kinds in families.items() if kind in kinds), None)
+        return BLEND_IDEA
+    found = (i for i, kinds in oc.families.items() if kind in kinds)
+    return next((i for i in found if oc.planner_of(i) == key.planner), None)
 
 
 def blend_at(key: ConfigKey, w: float) -> ConfigKey:
@@ -117,14 +124,14 @@ def evaluation_keys(
     chosen = list(
         dict.fromkeys(ConfigKey.parse(t) for per in envelopes.values() for t in per.values())
     )
-    blends = [k for k in chosen if idea_of(k, oc.families) == "blend"]
+    blends = [k for k in chosen if idea_of(k, oc) == BLEND_IDEA]
     blends = [blend_at(k, w) for k in blends for w in oc.blend_weights]
     base = [ConfigKey("rrt_star"), *(ConfigKey.parse(t, ev.sources) for t in rc.configurations)]
     every = list(dict.fromkeys([*base, *chosen, *blends]))
     quality = [
         diluted(k, q)
         for k in chosen
-        if idea_of(k, oc.families) in QUALITY_IDEAS
+        if idea_of(k, oc) in QUALITY_IDEAS
         for q in oc.qualities
         if q != 1.0
     ]
