@@ -2,13 +2,15 @@
 draws from exactly the disks that tau leaves of each blurred interior vertex (a Gaussian of
 sigma px, maximum 1, is >= tau within sigma sqrt(2 ln(1/tau)) px of its centre), through the
 same code as the trials; on a generated instance M-VNRRT* on it puts all its heatmap weight
-near the turning points, where the unmasked VNRRT* member does not; and the report names its
-envelope and the taut-vertex envelope apart from the vertex envelope."""
+near the turning points, where the unmasked VNRRT* member does not; the trained M-VNRRT* is
+read against its envelope; and the report names its envelope and the taut-vertex envelope apart
+from the vertex envelope."""
 
 import itertools
 import math
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from tests.evaluation.test_oracles import make_instance
@@ -21,6 +23,7 @@ from vnrrt.evaluation.trials import run_trials
 from vnrrt.planners import PlannerConfig
 from vnrrt.studies.sampling_ideas.design import MASKED_IDEA, family_members
 from vnrrt.studies.sampling_ideas.report import conclusion, envelope_table
+from vnrrt.studies.sampling_ideas.summary import network_rows
 
 CORNERS = [(8, 40), (40, 40)]  # the hand-made path's interior vertices (x, y), 32 px apart
 
@@ -123,3 +126,31 @@ def test_the_report_names_each_turning_point_family_apart():
     table = envelope_table(summary, "optimal").splitlines()
     assert table[0].split(" | ")[1:6] == ["path", "vertex", "taut_vertex", "masked_vertex", "blend"]
     assert "masked_vertex / path" in table[0] and "3.00x" in table[2]
+
+
+def _trials(key: str, source: str, iterations: list[int]) -> pd.DataFrame:
+    """Protocol-cell trials of ``key`` (one per instance, 4 base maps, 2 instances each)."""
+    n = len(iterations)
+    return pd.DataFrame({"regime": "protocol", "stop": "optimal", "key": key, "source": source,
+                         "instance": range(n), "cluster": [i // 2 for i in range(n)],
+                         "trial": 0, "success": True, "iterations": iterations,
+                         "time_to_stop": [i / 1e4 for i in iterations]})  # fmt: skip
+
+
+def test_the_trained_m_vnrrt_is_read_against_the_masked_envelope_at_its_tau():
+    masked = "m_vnrrt_star@0.5~0.9[oracle_vertex@s2]"
+    envelopes = {"optimal": {"vertex": "vnrrt_star~0.9[oracle_vertex@s2]", "masked_vertex": masked}}
+    table = pd.concat([
+        _trials(envelopes["optimal"]["vertex"], "oracle_vertex@s2", [100] * 8),
+        _trials(masked, "oracle_vertex@s2", [50] * 8),
+        _trials("vnrrt_star", "vertexnet", [400] * 8),
+        _trials("m_vnrrt_star@0.5", "vertexnet", [200] * 8),  # read against the masked one
+        _trials("m_vnrrt_star@0.9", "vertexnet", [200] * 8),  # another tau: not read
+        _trials("m_vnrrt_star@0.5{max}", "vertexnet", [200] * 8),  # a mask variant: not read
+    ])  # fmt: skip
+    rows = network_rows(table, envelopes, {"vertexnet": "vertex"}, (200, 0.95))
+    got = {r["configuration"]: (r["idea"], r["iterations"]["speedup"]) for r in rows}
+    assert got == {
+        "vnrrt_star": ("vertex", pytest.approx(101 / 401)),
+        "m_vnrrt_star@0.5": ("masked_vertex", pytest.approx(51 / 201)),
+    }

@@ -129,7 +129,7 @@ def w0_answer(blends: list[dict]) -> dict:
 def network_rows(table: pd.DataFrame, envelopes: dict, targets: dict, boot: tuple) -> list:
     """Each trained network against its family's envelope in the protocol's cell (a network
     above its envelope means the family is incomplete): NRRT* the path envelope's, VNRRT* the
-    vertex envelope's, M-VNRRT* (its own mask) the masked-vertex envelope's."""
+    vertex envelope's, M-VNRRT* (its own mask) the masked-vertex envelope's at its tau."""
     g, out = _groups(table), []
     for (cell, stop, text), rows in g.items():
         key = ConfigKey.parse(text)
@@ -138,8 +138,9 @@ def network_rows(table: pd.DataFrame, envelopes: dict, targets: dict, boot: tupl
             idea = None if key.mask else d.MASKED_IDEA
         if cell != d.PROTOCOL or key.named_source or key.free or idea is None:
             continue
-        env = g.get((cell, stop, envelopes.get(stop, {}).get(idea)))
-        if env is not None and not key.informed:
+        chosen = envelopes.get(stop, {}).get(idea)
+        env = g.get((cell, stop, chosen))
+        if env is not None and not key.informed and ConfigKey.parse(chosen).tau == key.tau:
             out.append(
                 {
                     "stop": stop,
@@ -154,9 +155,9 @@ def network_rows(table: pd.DataFrame, envelopes: dict, targets: dict, boot: tupl
 def quality_rows(cells: list[dict], oc, envelopes: dict) -> list[dict]:
     """The quality curve: the protocol cell's diluted envelopes, x = heatmap mass near the
     target in multiples of a uniform map's (``oc``: the ``oracle`` section); ``member``: the
-    envelope diluted (signal fraction
-    1), ``own``: it is the envelope chosen for the row's stop rule (``envelopes``: ``{stop:
-    {idea: key text}}``; the others are every other stop rule's, run under this one)."""
+    envelope diluted (signal fraction 1), ``own``: it is the envelope chosen for the row's
+    stop rule (``envelopes``: ``{stop: {idea: key text}}``; the others are every other stop
+    rule's, run under this one)."""
     out = []
     for r in cells:
         key = ConfigKey.parse(r["configuration"])
