@@ -76,6 +76,7 @@ CHANGED = {  # key -> a valid value other than the default's
     "oracle.qualities": [1.0, 0.3],
     "oracle.random_maps": 9,
     "oracle.trials": 3,
+    "oracle.per_cell": True,
     "oracle.parts": [0, 1],
     "regime.etas": [7.0],
     "regime.radius_modes": ["fixed2"],

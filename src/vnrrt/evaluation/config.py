@@ -168,6 +168,7 @@ class OracleConfig:
     random_maps: int
     selection_share: float
     trials: int
+    per_cell: bool  # also select in every regime cell (the selection instances, optimal stops)
     parts: list[int]
 
     def planner_of(self, idea: str) -> str:
@@ -208,22 +209,21 @@ class OracleConfig:
         ok = 0 < self.selection_share < 1
         check(ok, "oracle.selection_share", self.selection_share, "must be in (0, 1)")
         check(self.trials >= 2, "oracle.trials", self.trials, "must be >= 2 (paired CIs)")
+        check(isinstance(self.per_cell, bool), "oracle.per_cell", self.per_cell, "true or false")
         check_parts(self.parts, "oracle.parts")
 
 
 @dataclass
 @conf_defaults("regime")
-class RegimeConfig:
-    """The ``regime`` section: the planner-regime sweep (its cells and configurations)."""
+class RegimeGrid:
+    """``regime.etas``, ``radius_modes``, ``gamma_factors`` and ``goal_radii``: the cells of
+    the planner-regime sweep, for the stages that name them without running the sweep (the
+    selection per cell, ``oracle.per_cell``)."""
 
     etas: list[float]
     radius_modes: list[str]
     gamma_factors: list[float]
     goal_radii: list
-    configurations: list[str]
-    random_maps: int
-    trials: int
-    parts: list[int]
 
     def validate(self) -> None:
         ok = bool(self.etas) and all(e > 0 for e in self.etas)
@@ -235,6 +235,20 @@ class RegimeConfig:
         check(ok, "regime.gamma_factors", self.gamma_factors, "every factor must be finite, > 0")
         ok = all(g is None or g > 0 for g in self.goal_radii) and bool(self.goal_radii)
         check(ok, "regime.goal_radii", self.goal_radii, "null, > 0 px or .inf")
+
+
+@dataclass
+@conf_defaults("regime")
+class RegimeConfig(RegimeGrid):
+    """The ``regime`` section: the planner-regime sweep (its cells and configurations)."""
+
+    configurations: list[str]
+    random_maps: int
+    trials: int
+    parts: list[int]
+
+    def validate(self) -> None:
+        super().validate()
         for key in self.configurations:
             try:
                 ConfigKey.parse(key)

@@ -12,7 +12,10 @@
   M-VNRRT* at ``planner.tau`` the masked-vertex ones, a perfect M-VNRRT* heatmap; VNRRT* the
   others); every stop rule, ``oracle.trials`` trials each. Each
   family's best member per stop rule (the most RRT* iterations saved,
-  :func:`vnrrt.studies.sampling_ideas.selection.select`) is its **envelope**.
+  :func:`vnrrt.studies.sampling_ideas.selection.select`) is its **envelope**. With
+  ``oracle.per_cell`` the selection also runs in every other regime cell (the optimal stop
+  rules; :func:`selection_cells`), and each cell's own envelopes run in that cell
+  (:mod:`vnrrt.studies.sampling_ideas.per_cell`).
 * **Evaluation** (stage ``regime@<k>``): on the evaluation instances, in the protocol's cell
   and in every other cell of ``regime.etas x`` radius rules ``x regime.goal_radii``
   (:func:`regime_cells`; one with the protocol's own settings is the protocol's): RRT*,
@@ -29,7 +32,13 @@ import math
 
 import numpy as np
 
-from vnrrt.evaluation.config import BLEND_IDEA, Configurations, OracleConfig, RegimeConfig
+from vnrrt.evaluation.config import (
+    BLEND_IDEA,
+    Configurations,
+    OracleConfig,
+    RegimeConfig,
+    RegimeGrid,
+)
 from vnrrt.evaluation.keys import ConfigKey
 from vnrrt.evaluation.oracles import BLEND, OracleSource
 from vnrrt.evaluation.protocol import STOPS
@@ -115,12 +124,12 @@ def diluted(key: ConfigKey, q: float) -> ConfigKey:
     return key.with_source(OracleSource(o.kind, o.sigma, q, o.w).text)
 
 
-def evaluation_keys(
-    envelopes: dict, oc: OracleConfig, rc: RegimeConfig, ev: Configurations, protocol: dict
-) -> dict[str, list[ConfigKey]]:
+def evaluation_keys(envelopes: dict, oc: OracleConfig, rc: RegimeConfig, ev: Configurations,
+                    protocol: dict, own: dict | None = None) -> dict[str, list]:  # fmt: skip
     """``{cell: keys}`` of the evaluation (module doc); ``envelopes``: ``{stop: {idea: key
     text}}`` (:func:`vnrrt.studies.sampling_ideas.selection.select`); ``protocol``: the
-    protocol cell's settings (:func:`protocol_settings`)."""
+    protocol cell's settings (:func:`protocol_settings`); ``own``: ``{cell: envelopes}``, the
+    envelopes selected in each other cell (``oracle.per_cell``), run in that cell too."""
     chosen = list(
         dict.fromkeys(ConfigKey.parse(t) for per in envelopes.values() for t in per.values())
     )
@@ -137,13 +146,34 @@ def evaluation_keys(
     ]
     flipped = [k.with_free(not ev.zero_obstacles) for k in [*base, *chosen]]
     cells = {PROTOCOL: list(dict.fromkeys([*every, *quality, *flipped]))}
-    cells |= {label: every for label in regime_cells(rc, protocol)}
+    for label in regime_cells(rc, protocol):
+        mine = [
+            ConfigKey.parse(t) for per in (own or {}).get(label, {}).values() for t in per.values()
+        ]
+        cells[label] = list(dict.fromkeys([*every, *mine]))
     return cells
 
 
-def oracle_counts(oc: OracleConfig) -> dict[tuple[str, str], int]:
-    """Trials per selection instance for every stop rule."""
-    return {("random", stop): oc.trials for stop in STOPS}
+SELECTED_HERE = ""  # the selection table's label of the protocol's cell (its first selection)
+
+
+def selection_cells(oc: OracleConfig, grid: RegimeGrid | None, protocol: dict) -> dict:
+    """``{label: planner overrides}`` of the cells the selection runs in: the protocol's
+    (:data:`SELECTED_HERE`, no override) and, with ``oracle.per_cell``, every other regime cell
+    of ``grid`` (:func:`regime_cells`, distinct settings only)."""
+    cells: dict[str, dict] = {SELECTED_HERE: {}}
+    if oc.per_cell:
+        if grid is None:
+            raise ValueError("oracle.per_cell needs the regime cells (regime.etas, ...)")
+        cells |= regime_cells(grid, protocol)
+    return cells
+
+
+def oracle_counts(oc: OracleConfig, cell: str = SELECTED_HERE) -> dict[tuple[str, str], int]:
+    """Trials per selection instance: every stop rule in the protocol's cell, the optimal ones
+    in the others (as :func:`evaluation_counts`)."""
+    stops = STOPS if cell == SELECTED_HERE else ("optimal", "optimal_any_angle")
+    return {("random", stop): oc.trials for stop in stops}
 
 
 def evaluation_counts(rc: RegimeConfig, cell: str) -> dict[tuple[str, str], int]:
@@ -153,7 +183,7 @@ def evaluation_counts(rc: RegimeConfig, cell: str) -> dict[tuple[str, str], int]
     return {("random", stop): rc.trials for stop in stops}
 
 
-def radius_rules(rc: RegimeConfig) -> list[tuple[str, dict]]:
+def radius_rules(rc: RegimeGrid) -> list[tuple[str, dict]]:
     """``(label, planner overrides)`` of each near-radius rule: ``shrinking`` at every
     ``regime.gamma_factors`` (``shrinking*0.1``), ``fixedK`` (K x eta)."""
     out = []
@@ -182,7 +212,7 @@ def protocol_settings(planner) -> dict:
     return {k: getattr(planner, k) for k in CELL_SETTINGS}
 
 
-def regime_cells(rc: RegimeConfig, protocol: dict) -> dict[str, dict]:
+def regime_cells(rc: RegimeGrid, protocol: dict) -> dict[str, dict]:
     """``{label: planner overrides}`` of every cell besides the protocol's, e.g.
     ``eta=5 radius=shrinking*0.1 goal=inf``: ``{"eta": 5.0, "radius_mode": "shrinking",
     "gamma_factor": 0.1, "goal_radius": inf}``. Left out: an unlimited step with a fixed

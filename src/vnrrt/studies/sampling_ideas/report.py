@@ -13,6 +13,7 @@ from vnrrt.evaluation.keys import ConfigKey, label
 from vnrrt.names import level_name, percent, stop_name
 from vnrrt.studies.sampling_ideas.design import PROTOCOL
 from vnrrt.studies.sampling_ideas.edges import edge_note
+from vnrrt.studies.sampling_ideas.per_cell import own_finding, own_table
 from vnrrt.studies.sampling_ideas.summary import sweep_columns
 
 IDEAS = ("path", "vertex", "taut_vertex", "masked_vertex", "blend", "control")  # shown in order
@@ -24,6 +25,12 @@ VERTEX_IDEAS = {  # the turning-point families, each against the path envelope i
     "its mask on the vertex oracle, the bound of the masked claims)",
 }
 OPTIMAL_STOPS = ("optimal", "optimal_any_angle")
+OWN_TEXT = (
+    "Each family's member also selected in each regime cell, on the selection instances' runs "
+    "in that cell (`oracle.per_cell`), and run there on the evaluation instances: fewer "
+    "iterations than RRT*, than the protocol cell's selection (in that cell) and than the "
+    "cell's own path envelope."
+)
 
 
 def ideas_of(summary: dict) -> list[str]:
@@ -197,6 +204,7 @@ def conclusion(summary: dict) -> list[str]:
     for stop in OPTIMAL_STOPS:
         out += _envelope_findings(summary, stop, eps)
         out += _winner_finding(summary, stop, eps)
+        out += own_finding(summary.get("own", []), stop, eps)
         w0 = summary["w0"].get(stop)
         if w0:
             out.append(
@@ -455,6 +463,10 @@ def build_ideas_report(summary: dict, scale: str, figures: list[str]) -> str:
             blend_table(summary, stop),
             "",
         ]
+    if summary.get("own"):
+        parts += ["## Envelopes selected in each regime cell", "", OWN_TEXT, ""]
+        for stop in OPTIMAL_STOPS:
+            parts += [f"### {stop_name(stop, eps)}", "", own_table(summary["own"], stop), ""]
     parts += [
         "## The heatmap-quality curve",
         "",

@@ -22,7 +22,8 @@ from vnrrt.evaluation.stats import compare
 from vnrrt.studies.sampling_ideas import design as d
 from vnrrt.studies.sampling_ideas.distinct import effective_keys, groups
 from vnrrt.studies.sampling_ideas.edges import envelope_edges
-from vnrrt.studies.sampling_ideas.selection import member_speedups, select
+from vnrrt.studies.sampling_ideas.per_cell import own_rows
+from vnrrt.studies.sampling_ideas.selection import by_cell
 
 BASELINE = ConfigKey("rrt_star")
 METRICS = ("iterations", "time_to_stop")
@@ -303,8 +304,7 @@ def analyze_study(tables: dict, study: dict, pairs: list[tuple[str, str]], setti
     oc, rc = study["oracle"], study["regime"]
     boot = (int(settings["bootstrap"]), float(settings["level"]))
     sel, ev = tables["oracle"], tables["regime"]
-    speedups = member_speedups(sel, d.family_members(oc, study["tau"]))
-    envelopes = select(speedups)
+    speedups, envelopes, own = by_cell(sel, d.family_members(oc, study["tau"]))
     cells = cell_rows(ev, boot) if len(ev) else []
     blends = blend_rows(ev, envelopes, oc.blend_weights, boot) if len(ev) else []
     return {
@@ -313,11 +313,15 @@ def analyze_study(tables: dict, study: dict, pairs: list[tuple[str, str]], setti
             "speedups": speedups,
             "envelopes": envelopes,
             "edges": envelope_edges(envelopes, oc),
+            "cells": own,
             "instances": int(sel["instance"].nunique()),
             "maps": sorted(int(c) for c in sel["cluster"].unique()),
         },
         "cells": cells,
         "envelopes": envelope_rows(ev, envelopes, boot) if len(ev) else [],
+        "own": own_rows(ev, envelopes, own, lambda b, p: {m: _cmp(b, p, m, boot) for m in METRICS})
+        if len(ev)
+        else [],
         "blend": blends,
         "w0": w0_answer(blends),
         "networks": network_rows(ev, envelopes, study.get("targets", {}), boot) if len(ev) else [],
