@@ -99,3 +99,26 @@ def test_a_cells_own_envelope_is_read_against_rrt_the_protocols_and_its_path():
     table_text = own_table(rows, "optimal")
     assert f"| {INF} | path | NRRT* mix 0.5 [oracle_path@s4] | 19.63x" in table_text
     assert own_table(rows, "optimal_any_angle") == "(not run)"
+
+
+def test_the_selection_stage_plans_every_cell_with_its_own_settings(monkeypatch):
+    """Stage ``oracle@0`` at the smoke scale (per_cell on), through the restricted view the
+    stage gets: the protocol's jobs (every stop rule) first, then each regime cell's (the
+    optimal ones), each with a planner setting the run has."""
+    from vnrrt.config import REPO_ROOT, compose, restrict, stage_params
+    from vnrrt.pipeline.sampling_ideas import Study, _study, part_settings
+
+    cfg = restrict(compose(["scale=smoke"]), stage_params("oracle@0", REPO_ROOT / "dvc.yaml"))
+    s = part_settings(cfg, "oracle")
+    st = _study(s)
+    monkeypatch.setattr(Study, "instances", lambda self: (["random"] * 4, [0, 2], [1, 3]))
+    jobs = st.selection_jobs()
+    cells = st.selection_cells()
+    assert list(cells) == ["", INF] and cells[INF]["eta"] == float("inf")
+    keys = d.selection_keys(st.oracle, s["planner"].tau)
+    per = {c: [j for j in jobs if j.regime == c] for c in cells}
+    trials = st.oracle.trials
+    assert sum(j.count for j in per[""]) == len(keys) * 2 * 3 * trials
+    assert sum(j.count for j in per[INF]) == len(keys) * 2 * 2 * trials
+    assert {j.stop for j in per[INF]} == {"optimal", "optimal_any_angle"}
+    assert [j.seq for j in jobs] == sorted(j.seq for j in jobs) and jobs[0].regime == ""
