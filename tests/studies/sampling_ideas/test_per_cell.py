@@ -92,6 +92,8 @@ def test_a_cells_own_envelope_is_read_against_rrt_the_protocols_and_its_path():
     assert by["path"]["over_rrt"]["iterations"]["speedup"] == pytest.approx(1001 / 51)
     assert by["path"]["vs_protocol"]["iterations"]["speedup"] == pytest.approx(401 / 51)
     assert "vs_path" not in by["path"] and by["vertex"]["vs_path"]["iterations"]["speedup"] == 1
+    assert own_finding(rows, "optimal", 0.01, distinct={"protocol": ["protocol"]}) == []
+    assert own_finding(rows, "optimal", 0.01, {INF: [INF]}) == own_finding(rows, "optimal", 0.01)
     said = own_finding(rows, "optimal", 0.01)[0]
     assert (
         "2 of 2 (cell, family) envelopes differ" in said and "2 of them save clearly more" in said

@@ -69,10 +69,11 @@ def own_table(rows: list[dict], stop: str) -> str:
     return "\n".join(lines)
 
 
-def own_finding(rows: list[dict], stop: str, eps: float) -> list[str]:
+def own_finding(rows: list[dict], stop: str, eps: float, distinct=None) -> list[str]:
     """How often selecting in the cell changed the member and clearly saved more (or fewer)
-    iterations than the protocol's selection (CI above or below 1)."""
-    mine = [r for r in rows if r["stop"] == stop]
+    iterations than the protocol's selection (CI above or below 1), over the ``distinct``
+    cells (:mod:`.distinct`'s representatives; None: every cell)."""
+    mine = [r for r in rows if r["stop"] == stop and (distinct is None or r["regime"] in distinct)]
     if not mine:
         return []
     moved = [r for r in mine if r["configuration"] != r["protocol_choice"]]
@@ -80,8 +81,8 @@ def own_finding(rows: list[dict], stop: str, eps: float) -> list[str]:
     more = sum(1 for s in its if s["ci_low"] > 1)
     fewer = sum(1 for s in its if s["ci_high"] < 1)
     return [
-        f"Selected in each regime cell ({stop_name(stop, eps)}, on the cell's own selection "
-        f"runs): {len(moved)} of {len(mine)} (cell, family) envelopes differ from the "
+        f"Selected in each distinct regime cell ({stop_name(stop, eps)}, on the cell's own "
+        f"selection runs): {len(moved)} of {len(mine)} (cell, family) envelopes differ from the "
         f"protocol's; {more} of them save clearly more iterations than it on the evaluation "
         f"instances, {fewer} clearly fewer, the rest no clear difference."
     ]

@@ -204,7 +204,7 @@ def conclusion(summary: dict) -> list[str]:
     for stop in OPTIMAL_STOPS:
         out += _envelope_findings(summary, stop, eps)
         out += _winner_finding(summary, stop, eps)
-        out += own_finding(summary.get("own", []), stop, eps)
+        out += own_finding(summary.get("own", []), stop, eps, _distinct(summary, stop)["groups"])
         w0 = summary["w0"].get(stop)
         if w0:
             out.append(
