@@ -96,12 +96,14 @@ def oracle_table(reports: Path = REPORTS) -> str:
     rows = ["| sampling near | " + " | ".join(stops.values()) + " |", "| --- | --- | --- |"]
     names = {
         "path": "the path",
-        "vertex": "the turning points",
+        "vertex": "the A* path's vertices",
+        "taut_vertex": "the true turning points (exact optimum)",
+        "masked_vertex": "the turning points, masked (a perfect M-VNRRT*)",
         "blend": "both (blend)",
         "control": "start and goal only",
     }
     edge = False
-    for idea, name in names.items():
+    for idea, name in ((i, n) for i, n in names.items() if i in found):
         cells = []
         for s in stops:
             value, flagged, _ = found[idea][s].partition(" (best measured member: ")

@@ -34,7 +34,7 @@ SETTINGS = {
     "bench_maps": bench_settings,
     "validate": validate_config,
 }
-DICT_VALUES = ("sources", "families")  # keys whose values are dicts
+DICT_VALUES = ("sources", "families", "planners")  # keys whose values are dicts
 CHANGED = {  # key -> a valid value other than the default's
     "eval.planners": ["rrt_star", "vnrrt_star"],
     "eval.sources": {"nrrt_star": "vertexnet", "vnrrt_star": "nrrtnet", "m_vnrrt_star": "nrrtnet"},
@@ -62,8 +62,11 @@ CHANGED = {  # key -> a valid value other than the default's
     "oracle.families": {  # Hydra merges a dict override into the default: every key given
         "path": ["oracle_path"],
         "vertex": ["oracle_vertex"],
+        "taut_vertex": ["oracle_taut_path"],
+        "masked_vertex": ["oracle_vertex_endpoints"],
         "control": ["oracle_endpoints"],
     },
+    "oracle.planners": {"path": "vnrrt_star", "masked_vertex": "nrrt_star"},
     "oracle.sigmas": [2.5],
     "oracle.mixes": [0.3],
     "oracle.blend_weights": [0.0, 0.4],
@@ -73,6 +76,7 @@ CHANGED = {  # key -> a valid value other than the default's
     "oracle.qualities": [1.0, 0.3],
     "oracle.random_maps": 9,
     "oracle.trials": 3,
+    "oracle.per_cell": True,
     "oracle.parts": [0, 1],
     "regime.etas": [7.0],
     "regime.radius_modes": ["fixed2"],

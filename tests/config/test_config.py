@@ -14,6 +14,7 @@ from vnrrt.config import (
     stage_params,
 )
 from vnrrt.data.config import LabelsConfig, ScaleConfig
+from vnrrt.evaluation.config import OracleConfig
 from vnrrt.maps.config import DataConfig
 from vnrrt.pipeline.params import main as params_main
 from vnrrt.pipeline.validate import validate_config
@@ -93,6 +94,33 @@ def test_a_section_must_give_every_key():
         section(OmegaConf.create({"labels": {}}), "labels", LabelsConfig)
     with pytest.raises(ConfigError, match="'labels' is missing"):
         section(OmegaConf.create({}), "labels", LabelsConfig)
+
+
+def test_a_given_mapping_replaces_the_defaults_whole():
+    """An older run's oracle families (one vertex family) gain none of today's defaults."""
+    cfg = compose()
+    OmegaConf.update(cfg, "oracle.families", {"path": ["oracle_path"],
+                     "vertex": ["oracle_vertex", "oracle_taut_vertex"]}, merge=False)  # fmt: skip
+    OmegaConf.update(cfg, "oracle.planners", {"path": "nrrt_star"}, merge=False)
+    oc = section(cfg, "oracle", OracleConfig)
+    assert oc.families == {"path": ["oracle_path"], "vertex": ["oracle_vertex",
+                                                               "oracle_taut_vertex"]}  # fmt: skip
+    assert oc.planners == {"path": "nrrt_star"}
+
+
+@pytest.mark.parametrize(
+    ("override", "message"),
+    [
+        ("oracle.mixes=[0.5,1.01]", "oracle.mixes"),
+        ("oracle.mixes=[0,0.5]", "oracle.mixes"),
+        ("oracle.planners.path=rrt_star", "oracle.planners.path"),
+        ("+oracle.planners.nofamily=nrrt_star", "oracle.planners.nofamily"),
+        ("oracle.planners.masked_vertex=vnrrt_star", "is in vertex too"),
+    ],
+)
+def test_bad_oracle_grids_and_planners_are_named(override, message):
+    with pytest.raises(ConfigError, match=message):
+        validate_config(compose([override]))
 
 
 def test_missing_empty_or_broken_params_files(tmp_path):

@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 from scipy import ndimage
 
+from vnrrt.config import ConfigError
 from vnrrt.data.instances import EvalInstance
 from vnrrt.evaluation.config import Configurations, OracleConfig, RegimeConfig
 from vnrrt.evaluation.keys import ConfigKey
@@ -30,6 +31,7 @@ from vnrrt.search import any_angle_path, astar, path_vertices
 from vnrrt.studies.sampling_ideas.design import (
     evaluation_keys,
     family_members,
+    idea_of,
     protocol_settings,
     regime_cells,
     selection_keys,
@@ -177,19 +179,42 @@ def test_oracle_sources_round_trip_and_refuse_bad_text():
 
 def test_the_families_hold_every_target_blur_and_mix():
     oc = OracleConfig(sigmas=[1.0, 4.0], mixes=[0.25, 0.75], blend_weights=[0.0, 1.0])
-    members = family_members(oc)
-    assert set(members) == {"path", "vertex", "control", "blend"}
-    assert len(members["vertex"]) == 3 * 2 * 2 and len(members["blend"]) == 2 * 2 * 2
-    texts = [k.text for k in selection_keys(oc)]
+    members = family_members(oc, tau=0.9)
+    ideas = {"path", "vertex", "taut_vertex", "masked_vertex", "control", "blend"}
+    assert set(members) == ideas
+    assert len(members["vertex"]) == 2 * 2 * 2 and len(members["blend"]) == 2 * 2 * 2
+    texts = [k.text for k in selection_keys(oc, tau=0.9)]
     assert texts[0] == "rrt_star" and len(texts) == len(set(texts))
     wanted = (
         "nrrt_star~0.25[oracle_path@s1]",
         "vnrrt_star~0.75[oracle_taut_vertex@s4]",
         "vnrrt_star~0.25[oracle_blend@w1@s4]",
         "vnrrt_star~0.75[oracle_endpoints@s1]",
+        "m_vnrrt_star@0.9~0.25[oracle_vertex_endpoints@s4]",  # a perfect M-VNRRT* heatmap
     )
     for text in wanted:
         assert text in texts, text
+    for idea, keys in members.items():  # each member is found in its own family again
+        assert {idea_of(k, oc) for k in keys} == {idea}, idea
+
+
+def test_the_default_grids_reach_mix_1_and_bad_families_are_named():
+    oc = OracleConfig()
+    oc.validate()
+    assert max(oc.mixes) == 1.0 and {0.9, 0.95} <= set(oc.mixes)
+    assert oc.planner_of("masked_vertex") == "m_vnrrt_star" and oc.planner_of("blend") == (
+        "vnrrt_star"
+    )
+    bad = (
+        ({"planners": {"nope": "nrrt_star"}}, "oracle.planners.nope"),
+        ({"planners": {"path": "rrt_star"}}, "oracle.planners.path"),
+        ({"planners": {"masked_vertex": "vnrrt_star"}}, "is in vertex too"),
+        ({"mixes": [0.5, 1.5]}, "oracle.mixes"),
+        ({"mixes": [0.0, 0.5]}, "oracle.mixes"),
+    )
+    for change, message in bad:
+        with pytest.raises(ConfigError, match=message):
+            OracleConfig(**change).validate()
 
 
 def test_selection_and_evaluation_share_no_base_map():

@@ -143,6 +143,9 @@ def section(cfg: DictConfig | dict, key: str, schema: type[T]) -> T:
         if isinstance(node, DictConfig):
             node = OmegaConf.to_container(node, resolve=True)
         merged = OmegaConf.merge(OmegaConf.structured(schema), node)
+        for name, value in node.items():  # a given mapping replaces the default's, whole
+            if isinstance(value, Mapping):
+                merged[name] = value
         obj = OmegaConf.to_object(merged)
     except OmegaConfBaseException as err:
         where = f"{key}.{err.full_key}" if getattr(err, "full_key", None) else key

@@ -18,6 +18,8 @@ from vnrrt.evaluation.keys import MASK_VARIANTS, ConfigKey
 from vnrrt.evaluation.oracles import ORACLE_KINDS
 from vnrrt.names import PLANNERS, mask_taus
 
+BLEND_IDEA = "blend"  # the family of the path-vertex blend (oracle.blend_weights)
+HEATMAP_PLANNERS = tuple(p for p in PLANNERS if p != "rrt_star")
 REGIME_RADIUS_MODES = ("shrinking", "fixed1", "fixed2")  # fixedK: a fixed near radius K x eta
 
 
@@ -156,6 +158,7 @@ class OracleConfig:
     (:mod:`vnrrt.studies.sampling_ideas`)."""
 
     families: dict[str, list[str]]
+    planners: dict[str, str]  # idea -> the planner sampling its oracles (others: vnrrt_star)
     sigmas: list[float]
     mixes: list[float]
     blend_weights: list[float]
@@ -165,7 +168,13 @@ class OracleConfig:
     random_maps: int
     selection_share: float
     trials: int
+    per_cell: bool  # also select in every regime cell (the selection instances, optimal stops)
     parts: list[int]
+
+    def planner_of(self, idea: str) -> str:
+        """The planner that samples family ``idea``'s oracles (``oracle.planners``;
+        ``vnrrt_star`` where it names none)."""
+        return self.planners.get(idea, "vnrrt_star")
 
     def validate(self) -> None:
         check(set(self.families) >= {"path", "vertex"}, "oracle.families", list(self.families),
@@ -174,6 +183,18 @@ class OracleConfig:
             bad = sorted(set(kinds) - set(ORACLE_KINDS))
             ok = bool(kinds) and not bad
             check(ok, f"oracle.families.{idea}", kinds, f"known: {ORACLE_KINDS}")
+        ideas = {*self.families, BLEND_IDEA}
+        for idea, planner in self.planners.items():
+            check(idea in ideas, f"oracle.planners.{idea}", planner,
+                  f"names no family of {sorted(ideas)}")  # fmt: skip
+            ok = planner in HEATMAP_PLANNERS
+            check(ok, f"oracle.planners.{idea}", planner, f"known: {HEATMAP_PLANNERS}")
+        seen: dict = {}
+        for idea, kinds in self.families.items():
+            for kind in kinds:
+                other = seen.setdefault((self.planner_of(idea), kind), idea)
+                check(other == idea, f"oracle.families.{idea}", kinds,
+                      f"{kind} is in {other} too, sampled by the same planner")  # fmt: skip
         ok = bool(self.sigmas) and all(s >= 0 for s in self.sigmas)
         check(ok, "oracle.sigmas", self.sigmas, "every blur must be >= 0 px")
         ok = bool(self.mixes) and all(0 < m <= 1 for m in self.mixes)
@@ -188,22 +209,21 @@ class OracleConfig:
         ok = 0 < self.selection_share < 1
         check(ok, "oracle.selection_share", self.selection_share, "must be in (0, 1)")
         check(self.trials >= 2, "oracle.trials", self.trials, "must be >= 2 (paired CIs)")
+        check(isinstance(self.per_cell, bool), "oracle.per_cell", self.per_cell, "true or false")
         check_parts(self.parts, "oracle.parts")
 
 
 @dataclass
 @conf_defaults("regime")
-class RegimeConfig:
-    """The ``regime`` section: the planner-regime sweep (its cells and configurations)."""
+class RegimeGrid:
+    """``regime.etas``, ``radius_modes``, ``gamma_factors`` and ``goal_radii``: the cells of
+    the planner-regime sweep, for the stages that name them without running the sweep (the
+    selection per cell, ``oracle.per_cell``)."""
 
     etas: list[float]
     radius_modes: list[str]
     gamma_factors: list[float]
     goal_radii: list
-    configurations: list[str]
-    random_maps: int
-    trials: int
-    parts: list[int]
 
     def validate(self) -> None:
         ok = bool(self.etas) and all(e > 0 for e in self.etas)
@@ -215,6 +235,20 @@ class RegimeConfig:
         check(ok, "regime.gamma_factors", self.gamma_factors, "every factor must be finite, > 0")
         ok = all(g is None or g > 0 for g in self.goal_radii) and bool(self.goal_radii)
         check(ok, "regime.goal_radii", self.goal_radii, "null, > 0 px or .inf")
+
+
+@dataclass
+@conf_defaults("regime")
+class RegimeConfig(RegimeGrid):
+    """The ``regime`` section: the planner-regime sweep (its cells and configurations)."""
+
+    configurations: list[str]
+    random_maps: int
+    trials: int
+    parts: list[int]
+
+    def validate(self) -> None:
+        super().validate()
         for key in self.configurations:
             try:
                 ConfigKey.parse(key)

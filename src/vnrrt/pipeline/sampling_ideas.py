@@ -2,7 +2,8 @@
 (:mod:`vnrrt.studies.sampling_ideas.design` says what runs).
 
 * ``oracle@<k>``: part ``k`` of the selection (every family member on the selection
-  instances) -> ``paths.oracle_part(k)``;
+  instances, in the protocol's cell and, with ``oracle.per_cell``, in every regime cell) ->
+  ``paths.oracle_part(k)``;
 * ``regime@<k>``: part ``k`` of the evaluation (the envelopes chosen from the merged selection,
   the networks, RRT*, in every regime cell, on the evaluation instances) ->
   ``paths.regime_part(k)``;
@@ -20,7 +21,7 @@ from omegaconf import DictConfig
 
 from vnrrt.config import ConfigError, check_parts, conf_defaults, section, sections
 from vnrrt.config.paths import Paths
-from vnrrt.evaluation.config import Configurations, OracleConfig, RegimeConfig, Rules
+from vnrrt.evaluation.config import Configurations, OracleConfig, RegimeConfig, RegimeGrid, Rules
 
 log = logging.getLogger(__name__)
 
@@ -53,7 +54,7 @@ class Study:
     regime: RegimeConfig | None
     seed: int
     protocol: dict
-    rules: Rules | None = None  # eps and max_iterations: the merged tables' checks
+    rules: Rules | None = None  # eps, max_iterations (the merged tables' checks), tau (M-VNRRT*)
 
     def design(self):
         """What the merged tables' rows must keep (:mod:`vnrrt.evaluation.invariants`)."""
@@ -75,35 +76,47 @@ class Study:
                                   self.oracle.selection_share, self.seed)  # fmt: skip
         return kinds, sel, ev
 
+    def selection_cells(self) -> dict:
+        """``{label: planner overrides}`` of the cells the selection runs in (design)."""
+        from vnrrt.studies.sampling_ideas.design import selection_cells
+
+        return selection_cells(self.oracle, self.regime, self.protocol)
+
     def selection_jobs(self) -> list:
-        """Every job of the selection, in canonical order."""
+        """Every job of the selection (the protocol's cell first), in canonical order."""
         from vnrrt.evaluation.protocol import trial_jobs
         from vnrrt.studies.sampling_ideas.design import oracle_counts, selection_keys
 
         kinds, sel, _ = self.instances()
-        return trial_jobs(kinds, selection_keys(self.oracle), oracle_counts(self.oracle),
-                          instances=sel)  # fmt: skip
+        keys, jobs = selection_keys(self.oracle, self.rules.tau), []
+        for cell in self.selection_cells():
+            seq = sum(j.count for j in jobs)
+            jobs += trial_jobs(kinds, keys, oracle_counts(self.oracle, cell), regimes=(cell,),
+                               instances=sel, seq=seq)  # fmt: skip
+        return jobs
 
-    def envelopes(self) -> tuple[dict, dict]:
-        """``(speed-ups, envelopes)`` of the merged selection
-        (:mod:`~vnrrt.studies.sampling_ideas.selection`)."""
+    def envelopes(self) -> tuple[dict, dict, dict]:
+        """``(speed-ups, envelopes, own)`` of the merged selection: the protocol cell's, and
+        each other cell's own envelopes
+        (:func:`~vnrrt.studies.sampling_ideas.selection.by_cell`)."""
         from vnrrt.evaluation.table import merge_parts
         from vnrrt.studies.sampling_ideas.design import family_members
-        from vnrrt.studies.sampling_ideas.selection import member_speedups, select
+        from vnrrt.studies.sampling_ideas.selection import by_cell
 
         rows = sum(j.count for j in self.selection_jobs())
         table = merge_parts(self.paths.oracle, self.oracle.parts, rows, self.design())
-        speedups = member_speedups(table, family_members(self.oracle))
-        return speedups, select(speedups)
+        return by_cell(table, family_members(self.oracle, self.rules.tau))
 
-    def evaluation_jobs(self, envelopes: dict) -> list:
-        """Every job of the evaluation (every cell, the protocol's first), canonical order."""
+    def evaluation_jobs(self, envelopes: dict, own: dict | None = None) -> list:
+        """Every job of the evaluation (every cell, the protocol's first), canonical order;
+        ``own``: each other cell's own envelopes, run there too."""
         from vnrrt.evaluation.protocol import trial_jobs
         from vnrrt.studies.sampling_ideas import design as d
 
         kinds, _, ev = self.instances()
         chosen, jobs = ev[: self.regime.random_maps], []
-        every = d.evaluation_keys(envelopes, self.oracle, self.regime, self.ev, self.protocol)
+        every = d.evaluation_keys(envelopes, self.oracle, self.regime, self.ev, self.protocol,
+                                  own)  # fmt: skip
         for cell, keys in every.items():
             counts = d.evaluation_counts(self.regime, cell)
             seq = sum(j.count for j in jobs)
@@ -121,7 +134,7 @@ def part_settings(cfg: DictConfig, which: str) -> dict:
     typed = sections(cfg, paths=Paths, eval=Configurations, oracle=OracleConfig)
     typed |= sections(cfg, planner=PlannerConfig)
     typed["protocol"] = protocol_settings(typed["planner"])
-    typed["regime"] = section(cfg, "regime", RegimeConfig) if which == "regime" else None
+    typed["regime"] = section(cfg, "regime", RegimeConfig if which == "regime" else RegimeGrid)
     if which == "regime":
         typed["predict"] = {"parts": check_parts(cfg.predict.parts, "predict.parts")}
         typed["train"] = {"seed": int(cfg.train.seed)}  # the networks' (the trials' network_seed)
@@ -180,10 +193,11 @@ def _part(jobs: list, part: int, parts: list[int], which: str) -> list:
 def run_oracle_part(cfg: DictConfig, part: int) -> int:
     """Stage ``oracle@<part>`` (module doc): returns the number of trials."""
     s = part_settings(cfg, "oracle")
-    st = _study(s)
+    st, planner = _study(s), s["planner"]
     jobs = _part(st.selection_jobs(), part, st.oracle.parts, "oracle")
     log.info("selection part %d/%d: %d jobs", part, len(st.oracle.parts), len(jobs))
-    return _run(s, jobs, {"": s["planner"]}, st.paths.oracle_part(part), [], "oracle")
+    configs = {label: planner.replace(**o) for label, o in st.selection_cells().items()}
+    return _run(s, jobs, configs, st.paths.oracle_part(part), [], "oracle")
 
 
 def run_regime_part(cfg: DictConfig, part: int) -> int:
@@ -193,8 +207,8 @@ def run_regime_part(cfg: DictConfig, part: int) -> int:
 
     s = part_settings(cfg, "regime")
     st, planner = _study(s), s["planner"]
-    _, envelopes = st.envelopes()
-    jobs = _part(st.evaluation_jobs(envelopes), part, st.regime.parts, "regime")
+    _, envelopes, own = st.envelopes()
+    jobs = _part(st.evaluation_jobs(envelopes, own), part, st.regime.parts, "regime")
     overrides = regime_cells(st.regime, st.protocol)
     cells = {label: planner.replace(**o) for label, o in overrides.items()}
     networks = sorted({j.key.source for j in jobs if j.key.source and not is_oracle(j.key.source)})
@@ -209,11 +223,11 @@ def ideas_tables(settings: dict) -> dict:
     from vnrrt.evaluation.table import merge_parts
 
     st = _study(settings)
-    _, envelopes = st.envelopes()
+    _, envelopes, own = st.envelopes()
     rows = sum(j.count for j in st.selection_jobs())
     design = st.design()
     oracle = merge_parts(st.paths.oracle, st.oracle.parts, rows, design)
-    rows = sum(j.count for j in st.evaluation_jobs(envelopes))
+    rows = sum(j.count for j in st.evaluation_jobs(envelopes, own))
     regime = merge_parts(st.paths.regime, st.regime.parts, rows, design)
     return {"oracle": oracle, "regime": regime}
 
@@ -234,7 +248,7 @@ def ideas_summary(tables: dict, settings: dict, free: dict[int, int] | None = No
     shown |= {"zero_obstacles": st.ev.zero_obstacles, "selection_share": st.oracle.selection_share}
     predict = read_json(st.paths.predict_metrics)["networks"]
     study = {"oracle": st.oracle, "regime": st.regime, "ev": st.ev, "protocol": st.protocol,
-             "targets": {n: m["target"] for n, m in predict.items()}}  # fmt: skip
+             "targets": {n: m["target"] for n, m in predict.items()}, "tau": rules.tau}  # fmt: skip
     return as_json(analyze_study(tables, study, pairs, shown, free))
 
 

@@ -13,13 +13,14 @@ from vnrrt.studies.sampling_ideas.selection import select
 
 def _oc(mixes, sigmas) -> OracleConfig:
     return OracleConfig(families={"path": ["oracle_path"], "vertex": ["oracle_vertex"]},
-                        mixes=mixes, sigmas=sigmas, blend_weights=[0.0, 0.5, 1.0])  # fmt: skip
+                        planners={"path": "nrrt_star"}, mixes=mixes, sigmas=sigmas,
+                        blend_weights=[0.0, 0.5, 1.0])  # fmt: skip
 
 
 def _speedups(oc: OracleConfig, score) -> dict:
     """``{stop: {idea: {key: score(key)}}}`` over every family member (a synthetic
     selection: the speed-up a member would have measured)."""
-    members = design.family_members(oc)
+    members = design.family_members(oc, tau=0.5)
     return {"optimal": {i: {k.text: score(k) for k in keys} for i, keys in members.items()}}
 
 

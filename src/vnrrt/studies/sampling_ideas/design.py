@@ -8,9 +8,14 @@
   every oracle family (:func:`family_members`): each target of ``oracle.families`` at each blur
   of ``oracle.sigmas`` and heatmap-draw probability of ``oracle.mixes``, and the path-vertex
   blend (:func:`vnrrt.evaluation.oracles.blend`) at each ``oracle.blend_weights`` x blur x
-  mix, all through the heatmap sampler; every stop rule, ``oracle.trials`` trials each. Each
+  mix, each sampled by its family's planner (``oracle.planners``: NRRT* the path oracles,
+  M-VNRRT* at ``planner.tau`` the masked-vertex ones, a perfect M-VNRRT* heatmap; VNRRT* the
+  others); every stop rule, ``oracle.trials`` trials each. Each
   family's best member per stop rule (the most RRT* iterations saved,
-  :func:`vnrrt.studies.sampling_ideas.selection.select`) is its **envelope**.
+  :func:`vnrrt.studies.sampling_ideas.selection.select`) is its **envelope**. With
+  ``oracle.per_cell`` the selection also runs in every other regime cell (the optimal stop
+  rules; :func:`selection_cells`), and each cell's own envelopes run in that cell
+  (:mod:`vnrrt.studies.sampling_ideas.per_cell`).
 * **Evaluation** (stage ``regime@<k>``): on the evaluation instances, in the protocol's cell
   and in every other cell of ``regime.etas x`` radius rules ``x regime.goal_radii``
   (:func:`regime_cells`; one with the protocol's own settings is the protocol's): RRT*,
@@ -27,15 +32,21 @@ import math
 
 import numpy as np
 
-from vnrrt.evaluation.config import Configurations, OracleConfig, RegimeConfig
+from vnrrt.evaluation.config import (
+    BLEND_IDEA,
+    Configurations,
+    OracleConfig,
+    RegimeConfig,
+    RegimeGrid,
+)
 from vnrrt.evaluation.keys import ConfigKey
 from vnrrt.evaluation.oracles import BLEND, OracleSource
 from vnrrt.evaluation.protocol import STOPS
 from vnrrt.studies.sampling_ideas.distinct import cell_key
 
 PROTOCOL = "protocol"  # the regime cell of the protocol's own planner settings
-IDEA_PLANNER = {"path": "nrrt_star"}  # path oracles are NRRT*'s idea; the others VNRRT*'s
 QUALITY_IDEAS = ("path", "vertex")  # the families of the quality curve
+MASKED_IDEA = "masked_vertex"  # the family a perfect M-VNRRT* heatmap is (oracle.planners)
 
 
 def split_instances(
@@ -55,21 +66,25 @@ def split_instances(
     return sel, ev
 
 
-def member(idea: str, source: OracleSource, mix: float) -> ConfigKey:
-    """The configuration sampling oracle ``source`` with heatmap-draw probability ``mix``."""
-    return ConfigKey(IDEA_PLANNER.get(idea, "vnrrt_star"), mix=mix).with_source(source.text)
+def member(planner: str, source: OracleSource, mix: float, tau: float) -> ConfigKey:
+    """The configuration in which ``planner`` samples oracle ``source`` with heatmap-draw
+    probability ``mix``; M-VNRRT* masks it below ``tau`` (an oracle's maximum is 1, so tau
+    reads as on a perfect network's probabilities, and as the ``max`` mask variant)."""
+    key = ConfigKey(planner, tau=float(tau) if planner == "m_vnrrt_star" else None, mix=mix)
+    return key.with_source(source.text)
 
 
-def family_members(oc: OracleConfig) -> dict[str, list[ConfigKey]]:
+def family_members(oc: OracleConfig, tau: float) -> dict[str, list[ConfigKey]]:
     """``{idea: members}``: every family of ``oracle.families`` and the ``blend`` (module
-    doc), in a fixed order."""
+    doc), in a fixed order, each sampled by its planner (``oracle.planners``; ``tau``:
+    ``planner.tau``, M-VNRRT*'s threshold)."""
     out = {}
     for idea, kinds in oc.families.items():
-        out[idea] = [
-            member(idea, OracleSource(k, s), m) for k in kinds for s in oc.sigmas for m in oc.mixes
-        ]
-    out["blend"] = [
-        member("blend", OracleSource(BLEND, s, w=w), m)
+        p, grid = oc.planner_of(idea), [(s, m) for s in oc.sigmas for m in oc.mixes]
+        out[idea] = [member(p, OracleSource(k, s), m, tau) for k in kinds for s, m in grid]
+    p = oc.planner_of(BLEND_IDEA)
+    out[BLEND_IDEA] = [
+        member(p, OracleSource(BLEND, s, w=w), m, tau)
         for w in oc.blend_weights
         for s in oc.sigmas
         for m in oc.mixes
@@ -77,23 +92,24 @@ def family_members(oc: OracleConfig) -> dict[str, list[ConfigKey]]:
     return out
 
 
-def selection_keys(oc: OracleConfig) -> list[ConfigKey]:
-    """RRT* and every family member (module doc), each once."""
+def selection_keys(oc: OracleConfig, tau: float) -> list[ConfigKey]:
+    """RRT* and every family member (module doc; ``tau``: ``planner.tau``), each once."""
     keys = [ConfigKey("rrt_star")]
-    for members in family_members(oc).values():
+    for members in family_members(oc, tau).values():
         keys += members
     return list(dict.fromkeys(keys))
 
 
-def idea_of(key: ConfigKey, families: dict[str, list[str]]) -> str | None:
-    """The family a configuration's oracle belongs to (``blend`` for the blend; None for
-    networks and RRT*)."""
+def idea_of(key: ConfigKey, oc: OracleConfig) -> str | None:
+    """The family a configuration's oracle belongs to: the one holding its oracle kind and
+    sampled by its planner (``blend`` for the blend; None for networks and RRT*)."""
     if not key.named_source or not key.source.startswith("oracle_"):
         return None
     kind = OracleSource.parse(key.source).kind
     if kind == BLEND:
-        return "blend"
-    return next((idea for idea, kinds in families.items() if kind in kinds), None)
+        return BLEND_IDEA
+    found = (i for i, kinds in oc.families.items() if kind in kinds)
+    return next((i for i in found if oc.planner_of(i) == key.planner), None)
 
 
 def blend_at(key: ConfigKey, w: float) -> ConfigKey:
@@ -108,35 +124,56 @@ def diluted(key: ConfigKey, q: float) -> ConfigKey:
     return key.with_source(OracleSource(o.kind, o.sigma, q, o.w).text)
 
 
-def evaluation_keys(
-    envelopes: dict, oc: OracleConfig, rc: RegimeConfig, ev: Configurations, protocol: dict
-) -> dict[str, list[ConfigKey]]:
+def evaluation_keys(envelopes: dict, oc: OracleConfig, rc: RegimeConfig, ev: Configurations,
+                    protocol: dict, own: dict | None = None) -> dict[str, list]:  # fmt: skip
     """``{cell: keys}`` of the evaluation (module doc); ``envelopes``: ``{stop: {idea: key
     text}}`` (:func:`vnrrt.studies.sampling_ideas.selection.select`); ``protocol``: the
-    protocol cell's settings (:func:`protocol_settings`)."""
+    protocol cell's settings (:func:`protocol_settings`); ``own``: ``{cell: envelopes}``, the
+    envelopes selected in each other cell (``oracle.per_cell``), run in that cell too."""
     chosen = list(
         dict.fromkeys(ConfigKey.parse(t) for per in envelopes.values() for t in per.values())
     )
-    blends = [k for k in chosen if idea_of(k, oc.families) == "blend"]
+    blends = [k for k in chosen if idea_of(k, oc) == BLEND_IDEA]
     blends = [blend_at(k, w) for k in blends for w in oc.blend_weights]
     base = [ConfigKey("rrt_star"), *(ConfigKey.parse(t, ev.sources) for t in rc.configurations)]
     every = list(dict.fromkeys([*base, *chosen, *blends]))
     quality = [
         diluted(k, q)
         for k in chosen
-        if idea_of(k, oc.families) in QUALITY_IDEAS
+        if idea_of(k, oc) in QUALITY_IDEAS
         for q in oc.qualities
         if q != 1.0
     ]
     flipped = [k.with_free(not ev.zero_obstacles) for k in [*base, *chosen]]
     cells = {PROTOCOL: list(dict.fromkeys([*every, *quality, *flipped]))}
-    cells |= {label: every for label in regime_cells(rc, protocol)}
+    for label in regime_cells(rc, protocol):
+        mine = [
+            ConfigKey.parse(t) for per in (own or {}).get(label, {}).values() for t in per.values()
+        ]
+        cells[label] = list(dict.fromkeys([*every, *mine]))
     return cells
 
 
-def oracle_counts(oc: OracleConfig) -> dict[tuple[str, str], int]:
-    """Trials per selection instance for every stop rule."""
-    return {("random", stop): oc.trials for stop in STOPS}
+SELECTED_HERE = ""  # the selection table's label of the protocol's cell (its first selection)
+
+
+def selection_cells(oc: OracleConfig, grid: RegimeGrid | None, protocol: dict) -> dict:
+    """``{label: planner overrides}`` of the cells the selection runs in: the protocol's
+    (:data:`SELECTED_HERE`, no override) and, with ``oracle.per_cell``, every other regime cell
+    of ``grid`` (:func:`regime_cells`, distinct settings only)."""
+    cells: dict[str, dict] = {SELECTED_HERE: {}}
+    if oc.per_cell:
+        if grid is None:
+            raise ValueError("oracle.per_cell needs the regime cells (regime.etas, ...)")
+        cells |= regime_cells(grid, protocol)
+    return cells
+
+
+def oracle_counts(oc: OracleConfig, cell: str = SELECTED_HERE) -> dict[tuple[str, str], int]:
+    """Trials per selection instance: every stop rule in the protocol's cell, the optimal ones
+    in the others (as :func:`evaluation_counts`)."""
+    stops = STOPS if cell == SELECTED_HERE else ("optimal", "optimal_any_angle")
+    return {("random", stop): oc.trials for stop in stops}
 
 
 def evaluation_counts(rc: RegimeConfig, cell: str) -> dict[tuple[str, str], int]:
@@ -146,7 +183,7 @@ def evaluation_counts(rc: RegimeConfig, cell: str) -> dict[tuple[str, str], int]
     return {("random", stop): rc.trials for stop in stops}
 
 
-def radius_rules(rc: RegimeConfig) -> list[tuple[str, dict]]:
+def radius_rules(rc: RegimeGrid) -> list[tuple[str, dict]]:
     """``(label, planner overrides)`` of each near-radius rule: ``shrinking`` at every
     ``regime.gamma_factors`` (``shrinking*0.1``), ``fixedK`` (K x eta)."""
     out = []
@@ -175,7 +212,7 @@ def protocol_settings(planner) -> dict:
     return {k: getattr(planner, k) for k in CELL_SETTINGS}
 
 
-def regime_cells(rc: RegimeConfig, protocol: dict) -> dict[str, dict]:
+def regime_cells(rc: RegimeGrid, protocol: dict) -> dict[str, dict]:
     """``{label: planner overrides}`` of every cell besides the protocol's, e.g.
     ``eta=5 radius=shrinking*0.1 goal=inf``: ``{"eta": 5.0, "radius_mode": "shrinking",
     "gamma_factor": 0.1, "goal_radius": inf}``. Left out: an unlimited step with a fixed

@@ -13,10 +13,31 @@ from vnrrt.evaluation.keys import ConfigKey, label
 from vnrrt.names import level_name, percent, stop_name
 from vnrrt.studies.sampling_ideas.design import PROTOCOL
 from vnrrt.studies.sampling_ideas.edges import edge_note
+from vnrrt.studies.sampling_ideas.per_cell import own_finding, own_table
 from vnrrt.studies.sampling_ideas.summary import sweep_columns
 
-IDEAS = ("path", "vertex", "blend", "control")
+IDEAS = ("path", "vertex", "taut_vertex", "masked_vertex", "blend", "control")  # shown in order
+VERTEX_IDEAS = {  # the turning-point families, each against the path envelope in the conclusion
+    "vertex": "near the A* path's vertices (the vertex envelope: the staircase's turns)",
+    "taut_vertex": "near the true turning points (the taut-vertex envelope: the exact "
+    "optimum's corners)",
+    "masked_vertex": "as M-VNRRT* with a perfect vertex heatmap (the masked-vertex envelope: "
+    "its mask on the vertex oracle, the bound of the masked claims)",
+}
 OPTIMAL_STOPS = ("optimal", "optimal_any_angle")
+OWN_TEXT = (
+    "Each family's member also selected in each regime cell, on the selection instances' runs "
+    "in that cell (`oracle.per_cell`), and run there on the evaluation instances: fewer "
+    "iterations than RRT*, than the protocol cell's selection (in that cell) and than the "
+    "cell's own path envelope."
+)
+
+
+def ideas_of(summary: dict) -> list[str]:
+    """The families with an envelope under some stop rule: :data:`IDEAS` first, in order,
+    then any other."""
+    found = dict.fromkeys(i for per in summary["selection"]["envelopes"].values() for i in per)
+    return [i for i in IDEAS if i in found] + [i for i in found if i not in IDEAS]
 
 
 def _x(s: dict | None) -> str:
@@ -58,23 +79,25 @@ def _envelope_findings(summary: dict, stop: str, eps: float) -> list[str]:
     rows = {
         r["idea"]: r for r in summary["envelopes"] if r["regime"] == PROTOCOL and r["stop"] == stop
     }
-    out = []
-    cells = {i: _cell(summary, PROTOCOL, stop, env.get(i)) for i in IDEAS}
+    out, ideas = [], ideas_of(summary)
+    cells = {i: _cell(summary, PROTOCOL, stop, env.get(i)) for i in ideas}
     edges = summary["selection"].get("edges", {}).get(stop, {})
     said = "; ".join(f"{i} {_x((cells[i] or {}).get('iterations'))}{edge_note(edges.get(i))}"
-                     for i in IDEAS if cells[i])  # fmt: skip
+                     for i in ideas if cells[i])  # fmt: skip
     if said:
         out.append(
             f"Envelopes ({stop_name(stop, eps)}, the protocol's cell, fewer iterations "
             f"than RRT*): {said}."
         )
-    if "vertex" in rows:
-        v = rows["vertex"]["iterations"]
-        word = _word(v, "fewer iterations than", "more iterations than", "no clear difference from")
-        out.append(
-            f"Sampling near the turning points (the vertex envelope) needs {word} "
-            f"sampling near the path (the path envelope): {_x(v)} ({stop_name(stop, eps)})."
-        )
+    for idea, how in VERTEX_IDEAS.items():
+        if idea in rows:
+            v = rows[idea]["iterations"]
+            word = _word(v, "fewer iterations than", "more iterations than",
+                         "no clear difference from")  # fmt: skip
+            out.append(
+                f"Sampling {how} needs {word} sampling near the path (the path envelope): "
+                f"{_x(v)} ({stop_name(stop, eps)})."
+            )
     return out
 
 
@@ -120,21 +143,25 @@ def _corrected(summary: dict, stop: str) -> str:
 
 
 def _winner_finding(summary: dict, stop: str, eps: float) -> list[str]:
-    won = cells_by_winner(summary, stop)
-    n = sum(len(v) for v in won.values())
-    if not n:
-        return []
+    """Per turning-point family (:data:`VERTEX_IDEAS`): the distinct cells its envelope or
+    the path envelope wins (:func:`cells_by_winner`)."""
 
     def named(cells: list[str]) -> str:
         return f" ({'; '.join(cells)})" if cells else ""
 
-    return [
-        f"Path envelope against vertex envelope, per regime cell ({stop_name(stop, eps)}): "
-        f"the path envelope needs clearly fewer iterations in {len(won['path'])} of {n} "
-        f"cells{named(won['path'])}; the vertex envelope in {len(won['vertex'])}"
-        f"{named(won['vertex'])}; no clear difference in {len(won['unclear'])}"
-        f"{_corrected(summary, stop)}."
-    ]
+    out = []
+    for idea in VERTEX_IDEAS:
+        won = cells_by_winner(summary, stop, idea)
+        n = sum(len(v) for v in won.values())
+        if n:
+            out.append(
+                f"Path envelope against {idea} envelope, per regime cell "
+                f"({stop_name(stop, eps)}): the path envelope needs clearly fewer iterations "
+                f"in {len(won['path'])} of {n} cells{named(won['path'])}; the {idea} envelope "
+                f"in {len(won[idea])}{named(won[idea])}; no clear difference in "
+                f"{len(won['unclear'])}{_corrected(summary, stop)}."
+            )
+    return out
 
 
 def censored_cells(summary: dict, stop: str) -> list[tuple[str, float, float, str]]:
@@ -177,6 +204,7 @@ def conclusion(summary: dict) -> list[str]:
     for stop in OPTIMAL_STOPS:
         out += _envelope_findings(summary, stop, eps)
         out += _winner_finding(summary, stop, eps)
+        out += own_finding(summary.get("own", []), stop, eps, _distinct(summary, stop)["groups"])
         w0 = summary["w0"].get(stop)
         if w0:
             out.append(
@@ -281,22 +309,22 @@ def _edge_cell(edges: list[str]) -> str:
 
 
 def envelope_table(summary: dict, stop: str) -> str:
-    """Per regime cell: each envelope's iteration speed-up over RRT* and the vertex and
-    blend envelopes against the path envelope."""
+    """Per regime cell: each envelope's iteration speed-up over RRT* and the turning-point
+    and blend envelopes against the path envelope."""
     env = summary["selection"]["envelopes"].get(stop, {})
     vs = {
         (r["regime"], r["idea"]): r["iterations"] for r in summary["envelopes"] if r["stop"] == stop
     }
-    head = "| cell | " + " | ".join(IDEAS) + " | vertex / path | blend / path |"
-    lines = [head, "|" + " --- |" * (len(IDEAS) + 3)]
+    ideas = ideas_of(summary)
+    against = [i for i in ideas if i in VERTEX_IDEAS or i == "blend"]
+    head = "| cell | " + " | ".join([*ideas, *(f"{i} / path" for i in against)]) + " |"
+    lines = [head, "|" + " --- |" * (len(ideas) + len(against) + 1)]
     for cell in summary["cell_names"]:
-        got = [_x((_cell(summary, cell, stop, env.get(i)) or {}).get("iterations")) for i in IDEAS]
+        got = [_x((_cell(summary, cell, stop, env.get(i)) or {}).get("iterations")) for i in ideas]
         if all(g == "—" for g in got):
             continue
-        lines.append(
-            f"| {cell} | " + " | ".join(got) + f" | {_x(vs.get((cell, 'vertex')))} | "
-            f"{_x(vs.get((cell, 'blend')))} |"
-        )
+        got += [_x(vs.get((cell, i))) for i in against]
+        lines.append(f"| {cell} | " + " | ".join(got) + " |")
     return "\n".join(lines)
 
 
@@ -425,8 +453,8 @@ def build_ideas_report(summary: dict, scale: str, figures: list[str]) -> str:
             "",
             selection_table(summary, stop),
             "",
-            "Evaluation (fewer iterations than RRT*, "
-            "and the vertex and blend envelopes against the path envelope):",
+            "Evaluation (fewer iterations than RRT*, and the turning-point and blend "
+            "envelopes against the path envelope):",
             "",
             envelope_table(summary, stop),
             "",
@@ -435,6 +463,10 @@ def build_ideas_report(summary: dict, scale: str, figures: list[str]) -> str:
             blend_table(summary, stop),
             "",
         ]
+    if summary.get("own"):
+        parts += ["## Envelopes selected in each regime cell", "", OWN_TEXT, ""]
+        for stop in OPTIMAL_STOPS:
+            parts += [f"### {stop_name(stop, eps)}", "", own_table(summary["own"], stop), ""]
     parts += [
         "## The heatmap-quality curve",
         "",

@@ -2,7 +2,9 @@
 evaluation instances it is reported on): per stop rule, the member that saves RRT* the most
 iterations (the geometric mean over instances of median(RRT*) / median(member) iterations,
 :func:`vnrrt.evaluation.stats.compare`'s point estimate). Ties keep the first member in the
-order of :func:`vnrrt.studies.sampling_ideas.design.family_members`."""
+order of :func:`vnrrt.studies.sampling_ideas.design.family_members`. The selection table's
+``regime`` column names the cell a row ran in: ``""`` the protocol's (the envelopes), any
+other a regime cell's own selection (``oracle.per_cell``, :func:`by_cell`)."""
 
 from __future__ import annotations
 
@@ -11,6 +13,7 @@ import pandas as pd
 from vnrrt.evaluation.stats import compare
 
 BASELINE = "rrt_star"
+PROTOCOL_ROWS = ""  # the regime label of the protocol cell's selection rows
 SELECTION_METRIC = "iterations"
 
 
@@ -41,3 +44,14 @@ def select(speedups: dict) -> dict:
                 best = max(order, key=lambda k: (cells[k], -order.index(k)))
                 out.setdefault(stop, {})[idea] = best
     return out
+
+
+def by_cell(table: pd.DataFrame, members: dict[str, list]) -> tuple[dict, dict, dict]:
+    """``(speed-ups, envelopes, own)`` of a selection table: the protocol cell's member
+    speed-ups and envelopes (:func:`member_speedups`, :func:`select`) and ``own``: ``{cell:
+    {stop: {idea: key text}}}``, each other cell's envelopes, selected on its own rows."""
+    cells = dict(tuple(table.groupby("regime", sort=False)))
+    here = cells.pop(PROTOCOL_ROWS, table.iloc[:0])
+    speedups = member_speedups(here, members)
+    own = {cell: select(member_speedups(rows, members)) for cell, rows in cells.items()}
+    return speedups, select(speedups), own

@@ -22,7 +22,8 @@ from vnrrt.evaluation.stats import compare
 from vnrrt.studies.sampling_ideas import design as d
 from vnrrt.studies.sampling_ideas.distinct import effective_keys, groups
 from vnrrt.studies.sampling_ideas.edges import envelope_edges
-from vnrrt.studies.sampling_ideas.selection import member_speedups, select
+from vnrrt.studies.sampling_ideas.per_cell import own_rows
+from vnrrt.studies.sampling_ideas.selection import by_cell
 
 BASELINE = ConfigKey("rrt_star")
 METRICS = ("iterations", "time_to_stop")
@@ -69,13 +70,14 @@ def _mean(values: pd.Series) -> float | None:
 
 
 def envelope_rows(table: pd.DataFrame, envelopes: dict, boot: tuple) -> list[dict]:
-    """Per cell and stop rule: the vertex and the blend envelopes against the path envelope
-    (paired, iterations and time): above 1, faster than sampling near the path."""
+    """Per cell and stop rule: every other family's envelope (the vertex, taut-vertex and
+    masked-vertex ones, the blend, the control) against the path envelope (paired, iterations
+    and time): above 1, faster than sampling near the path."""
     g, out = _groups(table), []
     for (cell, stop), _ in table.groupby(["regime", "stop"], sort=False):
         env = envelopes.get(stop, {})
         path = g.get((cell, stop, env.get("path")))
-        for idea in ("vertex", "blend", "control"):
+        for idea in (i for i in env if i != "path"):
             rows = g.get((cell, stop, env.get(idea)))
             if path is not None and rows is not None:
                 out.append(
@@ -127,15 +129,19 @@ def w0_answer(blends: list[dict]) -> dict:
 
 def network_rows(table: pd.DataFrame, envelopes: dict, targets: dict, boot: tuple) -> list:
     """Each trained network against its family's envelope in the protocol's cell (a network
-    above its envelope means the family is incomplete)."""
+    above its envelope means the family is incomplete): NRRT* the path envelope's, VNRRT* the
+    vertex envelope's, M-VNRRT* (its own mask) the masked-vertex envelope's at its tau."""
     g, out = _groups(table), []
     for (cell, stop, text), rows in g.items():
         key = ConfigKey.parse(text)
         idea = IDEA_OF_TARGET.get(targets.get(str(rows["source"].iloc[0])))
-        if cell != d.PROTOCOL or key.named_source or key.free or idea is None or key.tau:
+        if key.tau is not None:
+            idea = None if key.mask else d.MASKED_IDEA
+        if cell != d.PROTOCOL or key.named_source or key.free or idea is None:
             continue
-        env = g.get((cell, stop, envelopes.get(stop, {}).get(idea)))
-        if env is not None and not key.informed:
+        chosen = envelopes.get(stop, {}).get(idea)
+        env = g.get((cell, stop, chosen))
+        if env is not None and not key.informed and ConfigKey.parse(chosen).tau == key.tau:
             out.append(
                 {
                     "stop": stop,
@@ -147,15 +153,16 @@ def network_rows(table: pd.DataFrame, envelopes: dict, targets: dict, boot: tupl
     return out
 
 
-def quality_rows(cells: list[dict], families: dict, envelopes: dict) -> list[dict]:
+def quality_rows(cells: list[dict], oc, envelopes: dict) -> list[dict]:
     """The quality curve: the protocol cell's diluted envelopes, x = heatmap mass near the
-    target in multiples of a uniform map's; ``member``: the envelope diluted (signal fraction
-    1), ``own``: it is the envelope chosen for the row's stop rule (``envelopes``: ``{stop:
-    {idea: key text}}``; the others are every other stop rule's, run under this one)."""
+    target in multiples of a uniform map's (``oc``: the ``oracle`` section); ``member``: the
+    envelope diluted (signal fraction 1), ``own``: it is the envelope chosen for the row's
+    stop rule (``envelopes``: ``{stop: {idea: key text}}``; the others are every other stop
+    rule's, run under this one)."""
     out = []
     for r in cells:
         key = ConfigKey.parse(r["configuration"])
-        idea = d.idea_of(key, families)
+        idea = d.idea_of(key, oc)
         if r["regime"] != d.PROTOCOL or idea not in d.QUALITY_IDEAS or key.free:
             continue
         q = OracleSource.parse(key.source).q
@@ -297,8 +304,7 @@ def analyze_study(tables: dict, study: dict, pairs: list[tuple[str, str]], setti
     oc, rc = study["oracle"], study["regime"]
     boot = (int(settings["bootstrap"]), float(settings["level"]))
     sel, ev = tables["oracle"], tables["regime"]
-    speedups = member_speedups(sel, d.family_members(oc))
-    envelopes = select(speedups)
+    speedups, envelopes, own = by_cell(sel, d.family_members(oc, study["tau"]))
     cells = cell_rows(ev, boot) if len(ev) else []
     blends = blend_rows(ev, envelopes, oc.blend_weights, boot) if len(ev) else []
     return {
@@ -307,15 +313,19 @@ def analyze_study(tables: dict, study: dict, pairs: list[tuple[str, str]], setti
             "speedups": speedups,
             "envelopes": envelopes,
             "edges": envelope_edges(envelopes, oc),
+            "cells": own,
             "instances": int(sel["instance"].nunique()),
             "maps": sorted(int(c) for c in sel["cluster"].unique()),
         },
         "cells": cells,
         "envelopes": envelope_rows(ev, envelopes, boot) if len(ev) else [],
+        "own": own_rows(ev, envelopes, own, lambda b, p: {m: _cmp(b, p, m, boot) for m in METRICS})
+        if len(ev)
+        else [],
         "blend": blends,
         "w0": w0_answer(blends),
         "networks": network_rows(ev, envelopes, study.get("targets", {}), boot) if len(ev) else [],
-        "curves": quality_rows(cells, oc.families, envelopes),
+        "curves": quality_rows(cells, oc, envelopes),
         "regime": flat(cells, "time_to_stop"),
         "placed": placed(cells),
         "regime_claims": regime_claims(cells, pairs, ev, boot) if len(ev) else [],
