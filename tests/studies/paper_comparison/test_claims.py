@@ -83,9 +83,9 @@ def test_the_masked_control_runs_through_m_vnrrts_sampler(monkeypatch):
     calls = []
     real = sampling_module.make_sampler
 
-    def spy(planner, shape, heatmap, config):
+    def spy(planner, shape, heatmap, *, config):
         calls.append((planner, round(float(np.asarray(heatmap).max()), 6), config.tau))
-        return real(planner, shape, heatmap, config)
+        return real(planner, shape, heatmap, config=config)
 
     monkeypatch.setattr(sampling_module, "make_sampler", spy)
     inst = wall_instance({"vertexnet": vertex, "nrrtnet": path})
