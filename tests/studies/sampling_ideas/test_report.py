@@ -52,9 +52,15 @@ def test_only_cells_with_runs_stopped_by_the_budget_are_listed():
         ("eta=inf", "rrt_star"): 1.0,
         ("eta=inf", "vnrrt_star"): 0.5,
     }
-    got = censored_cells(_summary({}, success), "optimal")
-    assert got == [("eta=10", 0.9, 0.75, "nrrt_star"), ("eta=inf", 1.0, 0.5, "vnrrt_star")]
-    table = budget_table(_summary({}, success), "optimal")
-    assert "| eta=10 | 90.0% | 75.0% | NRRT* |" in table and "protocol" not in table
+    summary = _summary({}, success)
+    for row in summary["cells"]:  # 3 runs of one configuration cut by the time budget
+        row["cut_by_time"] = (
+            3 if (row["regime"], row["configuration"]) == ("eta=10", "nrrt_star") else 0
+        )
+    got = censored_cells(summary, "optimal")
+    assert got == [("eta=10", 0.9, 0.75, "nrrt_star", 3), ("eta=inf", 1.0, 0.5, "vnrrt_star", 0)]
+    table = budget_table(summary, "optimal")
+    assert "| eta=10 | 90.0% | 75.0% | NRRT* | 3 |" in table and "protocol" not in table
+    assert "(3 in all)" in table and "| eta=inf | 100.0% | 50.0% | VNRRT* | 0 |" in table
     clean = {k: 1.0 for k in success}
     assert budget_table(_summary({}, clean), "optimal").startswith("Every run")

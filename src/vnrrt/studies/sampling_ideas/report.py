@@ -164,10 +164,10 @@ def _winner_finding(summary: dict, stop: str, eps: float) -> list[str]:
     return out
 
 
-def censored_cells(summary: dict, stop: str) -> list[tuple[str, float, float, str]]:
-    """``(cell, RRT*'s share, the lowest share, its configuration)`` for every regime cell
-    where some runs did not reach ``stop`` within the planner's budget, in the study's
-    order."""
+def censored_cells(summary: dict, stop: str) -> list[tuple[str, float, float, str, int]]:
+    """``(cell, RRT*'s share, the lowest share, its configuration, runs cut by the time
+    budget)`` for every regime cell where some runs did not reach ``stop`` within the
+    planner's budget, in the study's order."""
     out = []
     for cell in summary["cell_names"]:
         rows = [r for r in summary["cells"] if r["regime"] == cell and r["stop"] == stop]
@@ -176,24 +176,31 @@ def censored_cells(summary: dict, stop: str) -> list[tuple[str, float, float, st
             continue
         base = next((r for r in rows if r["configuration"] == "rrt_star"), None)
         rrt = base["success_rate"] if base else math.nan
-        out.append((cell, rrt, low["success_rate"], low["configuration"]))
+        cut = sum(r.get("cut_by_time", 0) for r in rows)
+        out.append((cell, rrt, low["success_rate"], low["configuration"], cut))
     return out
 
 
 def budget_table(summary: dict, stop: str) -> str:
-    """The cells with runs stopped by the budget (:func:`censored_cells`)."""
+    """The cells with runs stopped by the budget (:func:`censored_cells`), and how many of
+    their runs the time budget stopped (their iterations depend on the machine)."""
     rows = censored_cells(summary, stop)
     if not rows:
         return "Every run of every cell reached the stop rule within the budget."
+    cut = sum(r[4] for r in rows)
     lines = [
         "Runs that reached the stop rule within the budget, where some did not (the others "
         "enter the statistics at the budget, censored: RRT*'s censored runs make a speed-up a "
-        "lower bound, the planner's an upper bound):",
+        "lower bound, the planner's an upper bound). A run cut by the time budget "
+        "(`planner.max_seconds`) rather than the iteration budget stops at an iteration count "
+        "that depends on the machine's speed: the last column counts them over every "
+        f"configuration of the cell ({cut} in all"
+        + (")." if cut else "; every censored run here hit the iteration budget)."),
         "",
-        "| cell | RRT* | lowest | its configuration |",
-        "| --- | --- | --- | --- |",
+        "| cell | RRT* | lowest | its configuration | runs cut by time |",
+        "| --- | --- | --- | --- | --- |",
     ]
-    lines += [f"| {c} | {_pct(r)} | {_pct(lo)} | {label(k)} |" for c, r, lo, k in rows]
+    lines += [f"| {c} | {_pct(r)} | {_pct(lo)} | {label(k)} | {n} |" for c, r, lo, k, n in rows]
     return "\n".join(lines)
 
 
