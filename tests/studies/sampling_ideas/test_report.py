@@ -2,12 +2,8 @@
 in which regime cell (an interval containing 1 is never a win) and which cells have runs
 stopped by the budget."""
 
-from vnrrt.studies.sampling_ideas.report import (
-    _winner_finding,
-    budget_table,
-    cells_by_winner,
-    censored_cells,
-)
+from vnrrt.studies.sampling_ideas.findings import _winner_finding, cells_by_winner
+from vnrrt.studies.sampling_ideas.report import budget_table, censored_cells
 
 CELLS = ["protocol", "eta=10", "eta=40", "eta=inf"]
 

@@ -12,156 +12,18 @@ import math
 from vnrrt.evaluation.keys import ConfigKey, label
 from vnrrt.names import level_name, percent, stop_name
 from vnrrt.studies.sampling_ideas.design import PROTOCOL
-from vnrrt.studies.sampling_ideas.edges import edge_note
-from vnrrt.studies.sampling_ideas.per_cell import own_finding, own_table
-from vnrrt.studies.sampling_ideas.summary import sweep_columns
-
-IDEAS = ("path", "vertex", "taut_vertex", "masked_vertex", "blend", "control")  # shown in order
-VERTEX_IDEAS = {  # the turning-point families, each against the path envelope in the conclusion
-    "vertex": "near the A* path's vertices (the vertex envelope: the staircase's turns)",
-    "taut_vertex": "near the true turning points (the taut-vertex envelope: the exact "
-    "optimum's corners)",
-    "masked_vertex": "as M-VNRRT* with a perfect vertex heatmap (the masked-vertex envelope: "
-    "its mask on the vertex oracle, the bound of the masked claims)",
-}
-OPTIMAL_STOPS = ("optimal", "optimal_any_angle")
-OWN_TEXT = (
-    "Each family's member also selected in each regime cell, on the selection instances' runs "
-    "in that cell (`oracle.per_cell`), and run there on the evaluation instances: fewer "
-    "iterations than RRT*, than the protocol cell's selection (in that cell) and than the "
-    "cell's own path envelope."
+from vnrrt.studies.sampling_ideas.findings import (
+    OPTIMAL_STOPS,
+    OWN_TEXT,
+    VERTEX_IDEAS,
+    cell_row,
+    conclusion,
+    ideas_of,
+    pct,
+    speedup_text,
 )
-
-
-def ideas_of(summary: dict) -> list[str]:
-    """The families with an envelope under some stop rule: :data:`IDEAS` first, in order,
-    then any other."""
-    found = dict.fromkeys(i for per in summary["selection"]["envelopes"].values() for i in per)
-    return [i for i in IDEAS if i in found] + [i for i in found if i not in IDEAS]
-
-
-def _x(s: dict | None) -> str:
-    if not s or s.get("speedup") is None or not math.isfinite(s["speedup"]):
-        return "—"
-    lo, hi = s.get("ci_low"), s.get("ci_high")
-    if lo is None or not math.isfinite(lo):
-        return f"{s['speedup']:.2f}x"
-    return f"{s['speedup']:.2f}x [{lo:.2f}, {hi:.2f}]"
-
-
-def _pct(v) -> str:
-    return "—" if v is None or not math.isfinite(v) else f"{100 * v:.1f}%"
-
-
-def _word(s: dict, better: str, worse: str, same: str) -> str:
-    """``better`` when the CI lies above 1, ``worse`` below, else ``same`` (never a gain
-    for an interval that contains 1)."""
-    if s["ci_low"] is not None and s["ci_low"] > 1:
-        return better
-    if s["ci_high"] is not None and s["ci_high"] < 1:
-        return worse
-    return same
-
-
-def _cell(summary: dict, cell: str, stop: str, text: str | None) -> dict | None:
-    return next(
-        (
-            r
-            for r in summary["cells"]
-            if (r["regime"], r["stop"], r["configuration"]) == (cell, stop, text)
-        ),
-        None,
-    )
-
-
-def _envelope_findings(summary: dict, stop: str, eps: float) -> list[str]:
-    env = summary["selection"]["envelopes"].get(stop, {})
-    rows = {
-        r["idea"]: r for r in summary["envelopes"] if r["regime"] == PROTOCOL and r["stop"] == stop
-    }
-    out, ideas = [], ideas_of(summary)
-    cells = {i: _cell(summary, PROTOCOL, stop, env.get(i)) for i in ideas}
-    edges = summary["selection"].get("edges", {}).get(stop, {})
-    said = "; ".join(f"{i} {_x((cells[i] or {}).get('iterations'))}{edge_note(edges.get(i))}"
-                     for i in ideas if cells[i])  # fmt: skip
-    if said:
-        out.append(
-            f"Envelopes ({stop_name(stop, eps)}, the protocol's cell, fewer iterations "
-            f"than RRT*): {said}."
-        )
-    for idea, how in VERTEX_IDEAS.items():
-        if idea in rows:
-            v = rows[idea]["iterations"]
-            word = _word(v, "fewer iterations than", "more iterations than",
-                         "no clear difference from")  # fmt: skip
-            out.append(
-                f"Sampling {how} needs {word} sampling near the path (the path envelope): "
-                f"{_x(v)} ({stop_name(stop, eps)})."
-            )
-    return out
-
-
-def _distinct(summary: dict, stop: str) -> dict:
-    """A stop rule's distinct cells and their readings (:func:`~.summary.distinct_summary`),
-    or every cell's at the per-cell level where the summary has none."""
-    d = (summary.get("distinct") or {}).get("stops", {}).get(stop)
-    if d:
-        return d
-    cells = summary.get("cell_names", [])
-    claims = [c for c in summary.get("regime_claims", []) if c["stop"] == stop]
-    return {"groups": {c: [c] for c in cells}, "envelopes": summary["envelopes"],
-            "regime_claims": claims, "level": None}  # fmt: skip
-
-
-def cells_by_winner(summary: dict, stop: str, idea: str = "vertex") -> dict[str, list[str]]:
-    """``{"path": cells, idea: cells, "unclear": cells}``: the distinct regime cells (in the
-    study's order; :mod:`.distinct`) where the path envelope needs clearly fewer iterations
-    than the ``idea`` envelope (their paired ratio's CI, corrected over the distinct cells,
-    below 1), where ``idea``'s needs clearly fewer (CI above 1), and the others."""
-    d = _distinct(summary, stop)
-    out: dict[str, list[str]] = {"path": [], idea: [], "unclear": []}
-    rows = {
-        r["regime"]: r["iterations"]
-        for r in d["envelopes"]
-        if r["stop"] == stop and r["idea"] == idea
-    }
-    for cell in d["groups"]:
-        if cell in rows:
-            out[_word(rows[cell], idea, "path", "unclear")].append(cell)
-    return out
-
-
-def _corrected(summary: dict, stop: str) -> str:
-    """How the per-cell counts were made: over distinct cells, Bonferroni-corrected."""
-    d = _distinct(summary, stop)
-    if d["level"] is None:
-        return ""
-    same = [f"{' = '.join(cells)}" for cells in d["groups"].values() if len(cells) > 1]
-    merged = f"; the same runs: {'; '.join(same)}" if same else ""
-    return (f" (counted over {len(d['groups'])} distinct cells{merged}; each interval at "
-            f"{d['level']:.3%}, Bonferroni over the distinct cells)")  # fmt: skip
-
-
-def _winner_finding(summary: dict, stop: str, eps: float) -> list[str]:
-    """Per turning-point family (:data:`VERTEX_IDEAS`): the distinct cells its envelope or
-    the path envelope wins (:func:`cells_by_winner`)."""
-
-    def named(cells: list[str]) -> str:
-        return f" ({'; '.join(cells)})" if cells else ""
-
-    out = []
-    for idea in VERTEX_IDEAS:
-        won = cells_by_winner(summary, stop, idea)
-        n = sum(len(v) for v in won.values())
-        if n:
-            out.append(
-                f"Path envelope against {idea} envelope, per regime cell "
-                f"({stop_name(stop, eps)}): the path envelope needs clearly fewer iterations "
-                f"in {len(won['path'])} of {n} cells{named(won['path'])}; the {idea} envelope "
-                f"in {len(won[idea])}{named(won[idea])}; no clear difference in "
-                f"{len(won['unclear'])}{_corrected(summary, stop)}."
-            )
-    return out
+from vnrrt.studies.sampling_ideas.per_cell import own_table
+from vnrrt.studies.sampling_ideas.summary import sweep_columns
 
 
 def censored_cells(summary: dict, stop: str) -> list[tuple[str, float, float, str, int]]:
@@ -200,94 +62,8 @@ def budget_table(summary: dict, stop: str) -> str:
         "| cell | RRT* | lowest | its configuration | runs cut by time |",
         "| --- | --- | --- | --- | --- |",
     ]
-    lines += [f"| {c} | {_pct(r)} | {_pct(lo)} | {label(k)} | {n} |" for c, r, lo, k, n in rows]
+    lines += [f"| {c} | {pct(r)} | {pct(lo)} | {label(k)} | {n} |" for c, r, lo, k, n in rows]
     return "\n".join(lines)
-
-
-def conclusion(summary: dict) -> list[str]:
-    """Plain-language findings computed from the summary (module doc)."""
-    st, out = summary["settings"], []
-    eps = st["eps"]
-    for stop in OPTIMAL_STOPS:
-        out += _envelope_findings(summary, stop, eps)
-        out += _winner_finding(summary, stop, eps)
-        out += own_finding(summary.get("own", []), stop, eps, _distinct(summary, stop)["groups"])
-        w0 = summary["w0"].get(stop)
-        if w0:
-            out.append(
-                f"Does w = 0 (the path oracle) win at every step size ({stop_name(stop, eps)})? "
-                + (
-                    "Yes: no blend with w > 0 needs clearly fewer iterations in any cell."
-                    if w0["w0_wins_everywhere"]
-                    else "No: a blend with w > 0 needs clearly fewer iterations in "
-                    + ", ".join(w0["blend_wins"])
-                    + "."
-                )
-            )
-    for r in summary["networks"]:
-        if r["stop"] != "optimal":
-            continue
-        s = r["iterations"]
-        word = _word(
-            s,
-            "above its family's envelope (the family is incomplete: a member "
-            "this good was not among the oracles)",
-            "below its family's envelope",
-            "not clearly different from its family's envelope",
-        )
-        out.append(
-            f"The trained {label(r['configuration'])} is {word}: {_x(s)} of the "
-            f"{r['idea']} envelope's iterations saved ({stop_name('optimal', eps)})."
-        )
-    out += quality_needed(summary, eps)
-    claims = [c for stop in OPTIMAL_STOPS for c in _distinct(summary, stop)["regime_claims"]]
-    pairs = list(dict.fromkeys((c["planner"], c["baseline"]) for c in claims))
-    claims.sort(key=lambda c: (pairs.index((c["planner"], c["baseline"])), c["stop"]))
-    for c in claims:
-        n = len(c["holds"]) + len(c["reversed"]) + len(c["unclear"])
-        out.append(
-            f"{c['claim']} ({stop_name(c['stop'], eps)}): holds in {len(c['holds'])} of "
-            f"{n} distinct cells, reversed in {len(c['reversed'])}, unclear in "
-            f"{len(c['unclear'])}."
-        )
-    return out
-
-
-def quality_needed(summary: dict, eps: float) -> list[str]:
-    """Per idea: the heatmap quality (mass near the target, x a uniform map's) from which the
-    iteration speed-up's CI lies above 1 at that quality and every better one, from the
-    q > 0 points; "none needed" when q = 0 (a uniform map) already clears."""
-    out = []
-    for idea in ("path", "vertex"):
-        rows = [
-            r
-            for r in summary["curves"]
-            if r["idea"] == idea
-            and r["stop"] == "optimal"
-            and r["metric"] == "iterations"
-            and r["own"]
-        ]
-        if not rows:
-            continue
-        zero = [r for r in rows if r["q"] == 0.0]
-        if zero and zero[0]["ci_low"] is not None and zero[0]["ci_low"] > 1:
-            out.append(f"{idea} oracle: none needed (a uniform map already clears RRT*).")
-            continue
-        need = None
-        for r in sorted((r for r in rows if r["q"] > 0), key=lambda r: -r["q"]):
-            if r["ci_low"] is None or r["ci_low"] <= 1:
-                break
-            need = r
-        said = (
-            "never at these q"
-            if need is None
-            else (f"{need['x_uniform']:.1f}x a uniform map's mass (q = {need['q']:g})")
-        )
-        out.append(
-            f"Heatmap quality the {idea} idea needs for a clear gain over RRT* in "
-            f"iterations ({stop_name('optimal', eps)}; its envelope diluted): {said}."
-        )
-    return out
 
 
 def selection_table(summary: dict, stop: str) -> str:
@@ -327,10 +103,13 @@ def envelope_table(summary: dict, stop: str) -> str:
     head = "| cell | " + " | ".join([*ideas, *(f"{i} / path" for i in against)]) + " |"
     lines = [head, "|" + " --- |" * (len(ideas) + len(against) + 1)]
     for cell in summary["cell_names"]:
-        got = [_x((_cell(summary, cell, stop, env.get(i)) or {}).get("iterations")) for i in ideas]
+        got = [
+            speedup_text((cell_row(summary, cell, stop, env.get(i)) or {}).get("iterations"))
+            for i in ideas
+        ]
         if all(g == "—" for g in got):
             continue
-        got += [_x(vs.get((cell, i))) for i in against]
+        got += [speedup_text(vs.get((cell, i))) for i in against]
         lines.append(f"| {cell} | " + " | ".join(got) + " |")
     return "\n".join(lines)
 
@@ -348,7 +127,9 @@ def blend_table(summary: dict, stop: str) -> str:
     for cell in summary["cell_names"]:
         got = {b["w"]: b["iterations"] for b in rows if b["regime"] == cell}
         if got:
-            lines.append(f"| {cell} | " + " | ".join(_x(got.get(w)) for w in weights) + " |")
+            lines.append(
+                f"| {cell} | " + " | ".join(speedup_text(got.get(w)) for w in weights) + " |"
+            )
     return "\n".join(lines)
 
 
@@ -367,9 +148,8 @@ def quality_table(summary: dict, stop: str) -> str:
     for r in sorted(rows, key=lambda r: (r["idea"], not r["own"], r["member"], -r["q"])):
         x = "—" if r["x_uniform"] is None else f"{r['x_uniform']:.1f}x"
         name = label(r["member"]) + (" *" if r["own"] else "")
-        lines.append(
-            f"| {r['idea']} | {name} | {r['q']:g} | {_pct(r['heat_mass'])} | {x} | {_x(r)} |"
-        )
+        mass = pct(r["heat_mass"])
+        lines.append(f"| {r['idea']} | {name} | {r['q']:g} | {mass} | {x} | {speedup_text(r)} |")
     return "\n".join(lines)
 
 
@@ -392,7 +172,10 @@ def rule_table(summary: dict, stop: str) -> str:
     if not pairs:
         return "(not run)"
     lines = ["| configuration | every cell | free cells only |", "| --- | --- | --- |"]
-    lines += [f"| {label(k)} | {_x(v[False])} | {_x(v[True])} |" for k, v in pairs.items()]
+    lines += [
+        f"| {label(k)} | {speedup_text(v[False])} | {speedup_text(v[True])} |"
+        for k, v in pairs.items()
+    ]
     return "\n".join(lines)
 
 
@@ -409,7 +192,7 @@ def regime_section(summary: dict, stop: str) -> str:
     ]
     for cell in dict.fromkeys(r["regime"] for r in rows):
         got = {r["configuration"]: r for r in rows if r["regime"] == cell}
-        lines.append(f"| {cell} | " + " | ".join(_x(got.get(c)) for c in confs) + " |")
+        lines.append(f"| {cell} | " + " | ".join(speedup_text(got.get(c)) for c in confs) + " |")
     return "\n".join(lines)
 
 
