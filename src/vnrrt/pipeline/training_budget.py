@@ -200,7 +200,6 @@ def summary_settings(s: dict) -> dict:
     return {
         "scale": s["scale"]["name"],
         "train_seed": s["train"]["seed"],
-        "seeds": list(s["budget"].seeds),
         "eps": rules.eps,
         "tau": rules.tau,
         "level": st.level,

@@ -94,8 +94,9 @@ def budget_figure(summary: dict, metric: str):
         ax.legend(fontsize=7)
     axes[0, 0].set_ylabel(f"speed-up ({METRIC_NAMES[metric]})")
     axes[1, 0].set_ylabel(f"ratio ({METRIC_NAMES[metric]})")
-    seeds = ", ".join(str(v) for v in s.get("seeds", [s["train_seed"]]))
-    dots = "; dots: each seed's" if len(s.get("seeds", [])) > 1 else ""
+    seeds = summary.get("seeds", [s["train_seed"]])
+    dots = "; dots: each seed's" if len(seeds) > 1 else ""
+    seeds = ", ".join(str(v) for v in seeds)
     fig.suptitle(f"The networks over a training budget: {METRIC_NAMES[metric]} "
                  f"(bands: {level_name(s['level'])} CI{dots}; training seeds {seeds})",
                  fontsize=10)  # fmt: skip

@@ -99,6 +99,14 @@ def testability(cell: dict | None, max_endpoints: float, max_fallback: float) ->
     return {"testable": not why, "why": "; ".join(why)}
 
 
+def testability_rule(st) -> str:
+    """When a masked claim is not testable with a network (:func:`testability` with the
+    ``stats`` section ``st``'s thresholds), in the reports' words."""
+    return (f"more than {st.untestable_endpoint_share:.0%} of its sampler's mass lies on the "
+            f"start/goal disks, or it falls back to uniform sampling in more than "
+            f"{st.untestable_fallback:.0%} of its trials")  # fmt: skip
+
+
 def _pair(table: pd.DataFrame, paper: dict, claim: dict):
     """(baseline rows, planner rows) of a claim's table column; None if either is missing."""
     stop = paper["tables"][claim["table"]]["stop"]
@@ -198,10 +206,7 @@ def claims(table: pd.DataFrame, paper: dict, st, shares: dict, strata: dict | No
         row["testability"] = testability(cell, st.untestable_endpoint_share, st.untestable_fallback)
         rows.append(row)
     tails = n_boot * (1 - strict) / 2
-    rule = (f"more than {st.untestable_endpoint_share:.0%} of its sampler's mass lies on the "
-            f"start/goal disks, or it falls back to uniform sampling in more than "
-            f"{st.untestable_fallback:.0%} of its trials")  # fmt: skip
     return {"level": st.level, "claims": tested, "corrected_level": strict,
-            "bootstrap": n_boot, "tail_draws": tails, "testability_rule": rule,
+            "bootstrap": n_boot, "tail_draws": tails, "testability_rule": testability_rule(st),
             "pairing": list(st.pairing), "strata": names if strata is not None else [],
             "rows": rows}  # fmt: skip

@@ -18,7 +18,12 @@ from __future__ import annotations
 
 from vnrrt.evaluation.seeds import seed_compare
 from vnrrt.evaluation.stats import bonferroni_level, compare
-from vnrrt.studies.paper_comparison.claims import claim_boot, mask_shares, testability
+from vnrrt.studies.paper_comparison.claims import (
+    claim_boot,
+    mask_shares,
+    testability,
+    testability_rule,
+)
 from vnrrt.studies.paper_comparison.paper_noise import claim_interval
 from vnrrt.studies.paper_comparison.readings import difference, reading_verdict
 from vnrrt.studies.training_budget.pooled import paired_rows
@@ -88,11 +93,4 @@ def seed_claims(runs: list[dict], paper: dict, st, keys: list[str], tables: dict
                      "per_seed": per_seed, "testable_seeds": testable})  # fmt: skip
     return {"level": st.level, "corrected_level": strict, "bootstrap": n_boot,
             "seeds": [int(r["seed"]) for r in runs], "rows": rows,
-            "untestable_rule": _rule(st)}  # fmt: skip
-
-
-def _rule(st) -> str:
-    """When a masked claim is untestable with a network (as the paper comparison says)."""
-    return (f"more than {st.untestable_endpoint_share:.0%} of its sampler's mass on the "
-            f"start/goal disks, or uniform fallback in more than "
-            f"{st.untestable_fallback:.0%} of its trials")  # fmt: skip
+            "untestable_rule": testability_rule(st)}  # fmt: skip

@@ -4,18 +4,13 @@
 from __future__ import annotations
 
 from vnrrt.names import level_name
-
-
-def _pct(cell: dict) -> str:
-    """``-12.3% [-20.1%, -3.0%]`` of a reading (ratio - 1)."""
-    return (f"{cell['speedup'] - 1:+.1%} [{cell['ci_low'] - 1:+.1%}, "
-            f"{cell['ci_high'] - 1:+.1%}]")  # fmt: skip
+from vnrrt.studies.paper_comparison.claims import improvement
 
 
 def _seed_cell(seed: str, cell: dict) -> str:
     """One seed's time reading, its verdict and, if untestable, why."""
     t = cell["time_to_stop"]
-    text = f"{seed}: {_pct(t)}, {t['verdict']}"
+    text = f"{seed}: {improvement(t)}, {t['verdict']}"
     return text if cell["testability"]["testable"] else f"{text} (untestable)"
 
 
@@ -38,13 +33,13 @@ def seed_claims_section(summary: dict) -> list[str]:
              f"median(planner)), at {level_name(c['corrected_level'])} (Bonferroni over the "
              f"{len(c['rows'])} claims read here; {c['bootstrap']:,} resamples); verdicts as in "
              "the paper comparison, against the paper's value and its own interval. A masked "
-             f"claim is untestable with a network when its sampler has {c['untestable_rule']}.",
+             f"claim is untestable with a network when {c['untestable_rule']}.",
              "", "| " + " | ".join(head) + " |", "|" + " --- |" * len(head)]  # fmt: skip
     for row in c["rows"]:
         pooled = row["pooled"]
         per = "; ".join(_seed_cell(k, v) for k, v in row["per_seed"].items())
-        cells = [row["text"], f"{row['quoted']:+.2%}", _pct(pooled["time_to_stop"]),
-                 pooled["time_to_stop"]["verdict"], _pct(pooled["iterations"]), per,
+        cells = [row["text"], f"{row['quoted']:+.2%}", improvement(pooled["time_to_stop"]),
+                 pooled["time_to_stop"]["verdict"], improvement(pooled["iterations"]), per,
                  f"{row['testable_seeds']} of {len(row['per_seed'])}"]  # fmt: skip
         lines.append("| " + " | ".join(cells) + " |")
     return [*lines, ""]

@@ -109,10 +109,7 @@ def pooled_point(inputs: list[dict], settings: dict) -> dict:
 
 def label_across(verdicts: list[str]) -> str:
     """One trend label from the seeds' own (module doc)."""
-    kinds = set(verdicts)
-    if len(kinds) == 1:
-        return verdicts[0]
-    return "no clear trend" if kinds == {"no clear trend"} else "differs between seeds"
+    return verdicts[0] if len(set(verdicts)) == 1 else "differs between seeds"
 
 
 def seed_trends(inputs: list[dict], settings: dict) -> list[dict]:
