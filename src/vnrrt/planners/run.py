@@ -53,20 +53,16 @@ class Query(NamedTuple):
 
 
 class Setup:
-    """What every run of one planner on one map shares (as OMPL's ``setup()``), each made
-    when a run first needs it (a straight answer needs only the budget): the budgets, the
-    core's settings, the sampler as the core reads it and the tree's arrays (one run at a
-    time)."""
+    """What every run of one planner on one map shares (as OMPL's ``setup()``): the budgets
+    (made first: a straight answer needs only them), then, each when a run first needs it,
+    the core's settings, the sampler as the core reads it and the tree's arrays (one run at
+    a time)."""
 
     def __init__(self, occ: np.ndarray, cfg: PlannerConfig, sampler: Sampler):
         self.occ, self.cfg, self.sampler = occ, cfg, sampler
         self._tree: nodes.Arrays | None = None
-
-    @functools.cached_property
-    def budget(self) -> tuple[int, float]:
-        """``(max_iterations, max_seconds)`` on this map (:meth:`PlannerConfig.budgets`)."""
-        free = self.occ.size - np.count_nonzero(self.occ) if self.cfg.scales_budgets else 0
-        return self.cfg.budgets(free)
+        free = occ.size - np.count_nonzero(occ) if cfg.scales_budgets else 0
+        self.budget = cfg.budgets(free)  # (max_iterations, max_seconds) on this map
 
     @functools.cached_property
     def bucket(self) -> float:
@@ -154,8 +150,9 @@ def run(occ: np.ndarray, query: Query, *, planner: str, setup: Setup, seed) -> P
     reached = dict(zip(stops.tolist(), zip(times.tolist(), iters.tolist()), strict=True))
     c, t = tree.counters, tree.tree
     counts = (int(c.iters[0]), int(c.nodes[0]), int(c.checks[0]))
+    cost = float(np.add.reduce(arrays[1])) if len(arrays[0]) else math.inf  # = polyline_length
     return result(planner, query, setup.budget, reason=REASONS[code], reached=reached,
-                  elapsed=elapsed, counts=counts, arrays=arrays,
+                  elapsed=elapsed, counts=counts, cost=cost, arrays=arrays,
                   tree=(t.pts, t.links[:, nodes.PARENT]))  # fmt: skip
 
 
@@ -216,14 +213,15 @@ def grow_tree(occ, tree, scratch, counters, trace, rng, draws, stops, p, first, 
 
 def result(planner: str, query: Query, budget: tuple[int, float], *, reason: str,
            reached: dict[float, tuple[float, int]], elapsed: float, counts: tuple[int, int, int],
-           arrays, tree) -> PlanResult:  # fmt: skip
+           cost: float, arrays, tree) -> PlanResult:  # fmt: skip
     """The :class:`PlanResult` of a finished run with ``budget`` ``(max_iterations,
     max_seconds)``: ``reached[bound] = (seconds, iteration)`` for ``inf`` and each of
     ``query.bounds``; ``counts`` its ``(iterations, tree nodes N, collision checks)``;
-    ``arrays`` its path, segment lengths, trace iterations and costs (:func:`grow_tree`);
-    ``tree`` the node positions ``(>= N, 2)`` and parents ``(>= N,)``, copied when kept."""
+    ``cost`` its path's length (``inf``: none); ``arrays`` its path, segment lengths, trace
+    iterations and costs (:func:`grow_tree`); ``tree`` the node positions ``(>= N, 2)`` and
+    parents ``(>= N,)``, copied when kept."""
     iterations, n, checks = counts
-    path, segs, trace_iterations, trace_costs = arrays
+    path, _, trace_iterations, trace_costs = arrays
     first_time, first_iteration = reached[math.inf]
     keep = query.keep_tree
     return PlanResult(
@@ -231,7 +229,7 @@ def result(planner: str, query: Query, budget: tuple[int, float], *, reason: str
         success=reason == "solved",
         stop_reason=reason,
         path=path,
-        cost=float(np.add.reduce(segs)) if len(path) else math.inf,  # = polyline_length(path)
+        cost=cost,
         iterations=iterations,
         tree_size=n,
         collision_checks=checks,
@@ -243,7 +241,7 @@ def result(planner: str, query: Query, budget: tuple[int, float], *, reason: str
         trace_costs=trace_costs,
         reference_length=query.reference_length,
         target_cost=query.target,
-        milestones=tuple(Milestone(b, *reached[b]) for b in query.bounds),
+        milestones=tuple([Milestone(b, *reached[b]) for b in query.bounds]),
         fallback_uniform=query.fallback_uniform,
         setup_time=query.setup_time,
         budget=budget,
@@ -261,5 +259,5 @@ def straight_result(planner: str, d: float, found: float, query: Query,
     path, cost = np.array((query.start, query.goal)), np.array((d,))
     reached = {b: (found, 0) if d <= b else (math.nan, -1) for b in (math.inf, *query.bounds)}
     return result(planner, query, budget, reason="solved", reached=reached, elapsed=found,
-                  counts=(0, 2, 1), arrays=(path, cost, np.zeros(1, np.int64), cost),
+                  counts=(0, 2, 1), cost=d, arrays=(path, cost, np.zeros(1, np.int64), cost),
                   tree=(path, np.array((-1, 0), np.int64)))  # fmt: skip
