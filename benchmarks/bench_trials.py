@@ -30,7 +30,7 @@ from vnrrt.data.instances import EvalInstance
 from vnrrt.evaluation.config import EvalConfig
 from vnrrt.evaluation.oracles import instance_heatmap
 from vnrrt.evaluation.protocol import configurations, trial_counts, trial_jobs
-from vnrrt.evaluation.trials import LIBRARY_HEAT, HeatSettings, run_trials
+from vnrrt.evaluation.trials import LIBRARY_SETTINGS, TrialSettings, run_trials
 from vnrrt.maps.config import DataConfig
 from vnrrt.maps.generate import generate_map, map_rng
 from vnrrt.maps.named import NAMES, named_map
@@ -38,7 +38,7 @@ from vnrrt.planners import PlannerConfig, any_angle_path, taut_length, warmup
 from vnrrt.search import astar, path_vertices
 
 ORACLE = {"path": "oracle_path", "interior_vertices": "oracle_vertex"}  # network target -> oracle
-HEAT = LIBRARY_HEAT  # the oracles' blur and floor, the mass radii: the library's
+HEAT = LIBRARY_SETTINGS  # the oracles' blur and floor, the mass radii: the library's
 
 
 def instance(i: int, map_set: str, grid, start, goal, sources: dict[str, str]) -> EvalInstance:
@@ -97,7 +97,7 @@ def main() -> None:
               ("named", "optimal_any_angle"): k, ("random", "initial"): 1,
               ("random", "optimal"): 1, ("random", "optimal_any_angle"): 1}  # fmt: skip
     warmup()
-    heat = HeatSettings(HEAT.radius, HEAT.endpoint_radius, targets, HEAT.sigma, HEAT.floor)
+    heat = TrialSettings(HEAT.radius, HEAT.endpoint_radius, targets, HEAT.sigma, HEAT.floor)
     t0 = time.perf_counter()
     table = run_trials(insts, specs, counts, seed=0, workers=1, config=planner, heat=heat)
     wall = time.perf_counter() - t0

@@ -51,6 +51,7 @@ CHANGED = {  # key -> a valid value other than the default's
     "eval.masked_controls": False,
     "eval.endpoint_radius": 2.0,
     "eval.zero_obstacles": True,
+    "eval.cap_factor": 2.0,
     "eval.gpu": True,
     "stats.bootstrap": 300,
     "stats.level": 0.9,

@@ -81,7 +81,12 @@ CASES = {  # rule fragment -> the planted values of row ROW
     },
     "instance is one of the instances file's": {"instance": 10_000},
     "map and map_set are the instance's": {"map": "u_trap"},
-    "success exactly when stop_reason is solved": {"stop_reason": "max_iterations"},
+    "run_stop_reason is solved": {"run_stop_reason": "gave_up"},
+    "run_stop_reason equals stop_reason unless": {"run_stop_reason": "max_iterations"},
+    "success exactly when stop_reason is solved": {
+        "stop_reason": "max_iterations",
+        "run_stop_reason": "max_iterations",
+    },
     "a success has a path": {"cost": math.inf, "time_to_first": math.nan},
     "cost <= (1 + eps) x reference_length": {"cost": lambda r: 1.5 * r.reference_length},
     "cost is a length": {"cost": math.nan},
@@ -95,6 +100,7 @@ CASES = {  # rule fragment -> the planted values of row ROW
         "cost": math.inf,
         "success": False,
         "stop_reason": "max_iterations",
+        "run_stop_reason": "max_iterations",
     },
     "t_1.05x is NaN or in 0..time_to_stop": {"t_1.05x": -1.0},
 }
@@ -153,5 +159,6 @@ def test_a_tampered_bundle_is_exit_2_naming_file_row_and_rule(trials, tmp_path):
 def test_a_design_without_optima_leaves_the_cost_rule_unchecked(trials):
     bare = Design(EPS, BUDGET)
     bare.check(_planted(trials, cost=lambda r: 0.999 * r.reference_length, success=False,
-                        stop_reason="max_iterations"), "t")  # fmt: skip
+                        stop_reason="max_iterations", run_stop_reason="max_iterations"),
+               "t")  # fmt: skip
     assert Design(EPS, BUDGET).exact == {}

@@ -13,7 +13,7 @@ from vnrrt.evaluation.keys import ConfigKey
 from vnrrt.evaluation.noise import band, baseline_record, changes, timing_noise, within
 from vnrrt.evaluation.protocol import trial_jobs
 from vnrrt.evaluation.table import REPEAT_COLUMNS, SEEDED_COLUMNS
-from vnrrt.evaluation.trials import LIBRARY_HEAT, interleave, run_jobs
+from vnrrt.evaluation.trials import LIBRARY_SETTINGS, interleave, run_jobs
 from vnrrt.planners import PlannerConfig
 
 
@@ -37,8 +37,8 @@ def test_the_protocol_rrt_star_runs_twice_with_the_same_seeded_results():
             ConfigKey("rrt_star", informed=True)]  # fmt: skip
     counts = {("named", "initial"): 2, ("named", "optimal"): 2, ("random", "optimal"): 1}
     jobs = trial_jobs(["named", "random"], keys, counts)
-    once = run_jobs(jobs, instances, 0, 1, PlannerConfig(), LIBRARY_HEAT)
-    twice = run_jobs(jobs, instances, 0, 1, PlannerConfig(), LIBRARY_HEAT, repeat=True)
+    once = run_jobs(jobs, instances, 0, 1, PlannerConfig(), LIBRARY_SETTINGS)
+    twice = run_jobs(jobs, instances, 0, 1, PlannerConfig(), LIBRARY_SETTINGS, repeat=True)
     pd.testing.assert_frame_equal(once[list(SEEDED_COLUMNS)], twice[list(SEEDED_COLUMNS)])
     protocol = twice["key"] == "rrt_star"
     assert twice.loc[protocol, list(REPEAT_COLUMNS)].notna().all().all()

@@ -14,7 +14,7 @@ from vnrrt.evaluation import reuse, trials
 from vnrrt.evaluation.keys import ConfigKey
 from vnrrt.evaluation.protocol import trial_jobs
 from vnrrt.evaluation.table import SEEDED_COLUMNS, write_table
-from vnrrt.evaluation.trials import LIBRARY_HEAT, run_jobs
+from vnrrt.evaluation.trials import LIBRARY_SETTINGS, run_jobs
 from vnrrt.planners import PlannerConfig
 
 RRT, NRRT = ConfigKey("rrt_star"), ConfigKey("nrrt_star", source="path")
@@ -43,7 +43,7 @@ def calls(monkeypatch):
 
 def run(instances, keys, store, config=CONFIG, seed=0):
     jobs = trial_jobs([inst.kind for inst in instances.values()], keys, COUNTS)
-    return run_jobs(jobs, instances, seed, 1, config, LIBRARY_HEAT, store)
+    return run_jobs(jobs, instances, seed, 1, config, LIBRARY_SETTINGS, store)
 
 
 def csv(table, tmp_path, name) -> bytes:

@@ -1,5 +1,5 @@
 """Evaluation trials: the table schema, paired seeds, determinism across workers, failures as
-rows, and timings that exclude building the sampler."""
+rows, timings that exclude building the sampler, and the time budget applied after the run."""
 
 import dataclasses
 import time
@@ -12,9 +12,9 @@ from vnrrt.data.instances import EvalInstance
 from vnrrt.evaluation import sampling as sampling_module
 from vnrrt.evaluation.keys import ConfigKey
 from vnrrt.evaluation.protocol import trial_seed
-from vnrrt.evaluation.table import COLUMNS, CONVERGENCE_COLUMNS
-from vnrrt.evaluation.trials import run_trials
-from vnrrt.planners import PlannerConfig, plan
+from vnrrt.evaluation.table import COLUMNS, CONVERGENCE_COLUMNS, solved
+from vnrrt.evaluation.trials import LIBRARY_SETTINGS, run_trials, time_reading
+from vnrrt.planners import Milestone, PlannerConfig, plan
 from vnrrt.planners import planner as planner_api
 from vnrrt.search import any_angle_path, astar, path_vertices
 
@@ -136,3 +136,38 @@ def test_planning_time_excludes_building_the_sampler(monkeypatch):
     monkeypatch.setattr(sampling_module, "make_sampler", slow(sampling_module.make_sampler))
     table = run_trials([inst], SPECS[1:2], {("named", "initial"): 3}, workers=1)
     assert (table["setup_time"] >= SLOW).all() and (table["time_to_stop"] < SLOW).all()
+
+
+def test_the_time_budget_applies_after_the_run_and_spares_the_iterations():
+    """A run capped far above its time budget: the time readings see it stopped at the
+    budget, the iterations are those of a run that no time budget stopped (same seeds)."""
+    counts, budget = {("named", "optimal"): 3}, 1e-5  # 10 us: every run here takes longer
+    free = run_trials([wall_instance()], SPECS[:1], counts, config=PlannerConfig(), workers=1)
+    capped = dataclasses.replace(LIBRARY_SETTINGS, cap_factor=30.0 / budget)
+    tight = run_trials([wall_instance()], SPECS[:1], counts, workers=1, heat=capped,
+                       config=PlannerConfig(max_seconds=budget))  # fmt: skip
+    assert tight["iterations"].equals(free["iterations"]) and tight["cost"].equals(free["cost"])
+    assert (tight["run_stop_reason"] == "solved").all() and solved(tight, "iterations").all()
+    assert (tight["stop_reason"] == "max_seconds").all() and not solved(tight, "time").any()
+    assert (tight["time_to_stop"] == budget).all()
+    assert tight[list(CONVERGENCE_COLUMNS)].isna().all().all()
+    assert (free["run_stop_reason"] == free["stop_reason"]).all()
+
+
+def test_time_reading_cuts_a_run_at_the_budget():
+    r = plan(wall_instance().grid, (5.5, 50.5), (55.5, 50.5), stop="optimal",
+             reference_length=60.0, milestones=(200.0, 61.0), seed=1)  # fmt: skip
+    slow = dataclasses.replace(
+        r,
+        time_to_first=0.5,
+        time_to_stop=2.0,
+        milestones=(Milestone(200.0, 0.4, 3), Milestone(61.0, 1.5, 9)),
+    )
+    got = time_reading(slow, 1.0)
+    assert got["success"] is False and got["stop_reason"] == "max_seconds"
+    assert got["time_to_first"] == 0.5 and got["time_to_stop"] == 1.0
+    assert got["convergence"][0] == 0.4 and np.isnan(got["convergence"][1])
+    assert np.isnan(time_reading(slow, 0.3)["time_to_first"])
+    within = time_reading(slow, 2.0)
+    assert within["success"] == r.success and within["stop_reason"] == r.stop_reason
+    assert within["time_to_stop"] == 2.0 and within["convergence"] == (0.4, 1.5)

@@ -23,6 +23,14 @@ HEATMAP_PLANNERS = tuple(p for p in PLANNERS if p != "rrt_star")
 REGIME_RADIUS_MODES = ("shrinking", "fixed1", "fixed2")  # fixedK: a fixed near radius K x eta
 
 
+def check_cap_factor(value) -> float:
+    """``eval.cap_factor`` (a run's wall-clock cap over the time budget) as a float;
+    :class:`ConfigError` unless it is a finite number >= 1."""
+    ok = isinstance(value, int | float) and not isinstance(value, bool)
+    check(ok and 1.0 <= value < math.inf, "eval.cap_factor", value, "a finite number >= 1")
+    return float(value)
+
+
 @dataclass
 @conf_defaults("eval")
 class Configurations:
@@ -37,9 +45,11 @@ class Configurations:
     masked_controls: bool  # M-VNRRT* at planner.tau on the NRRT* network's heatmap
     endpoint_radius: float  # start/goal disks (px): the noends mask, the mass shares
     zero_obstacles: bool  # the obstacle rule: sample free cells only (heatmaps, uniform)
+    cap_factor: float  # a run's wall-clock cap, x planner.max_seconds (applied after the run)
 
     def validate(self) -> None:
         """Raise :class:`ConfigError` naming the first invalid value."""
+        check_cap_factor(self.cap_factor)
         bad = sorted(set(self.mask_variants) - set(MASK_VARIANTS))
         check(not bad, "eval.mask_variants", self.mask_variants, f"known: {list(MASK_VARIANTS)}")
         check(isinstance(self.masked_controls, bool), "eval.masked_controls",

@@ -6,7 +6,9 @@ the file, the row and the rule it breaks, instead of feeding the statistics.
 Rules (``i``: the row's instance; lengths in pixels, times in seconds):
 
 * **instances**: ``instance`` is one of the instances file's, with its map name and set;
-* **keys**: ``stop`` is a stop rule, ``stop_reason`` a planner's reason, ``key`` a
+* **keys**: ``stop`` is a stop rule, ``stop_reason`` and ``run_stop_reason`` a planner's
+  reasons (equal unless the time budget, applied after the run, stopped it: then
+  ``stop_reason`` is ``max_seconds``), ``key`` a
   configuration key whose planner is the row's ``planner`` (and, where the design is known,
   one of its configurations); ``trial`` >= 0;
 * **seeds**: ``seed`` is :func:`~vnrrt.evaluation.protocol.trial_seed` of the run's seed,
@@ -21,8 +23,9 @@ Rules (``i``: the row's instance; lengths in pixels, times in seconds):
 * **budget**: ``iterations`` (samples) in 0 .. ``planner.max_iterations``, ``tree_size``
   in 1 .. iterations + 2 (root, samples, goal), ``collision_checks`` >= 0;
 * **times**: ``time_to_stop`` and ``setup_time`` finite and >= 0; ``time_to_first``
-  finite, >= 0 and at most ``time_to_stop`` exactly when a path was found (NaN otherwise);
-  each convergence time NaN or within 0 .. ``time_to_stop``.
+  finite, >= 0 and at most ``time_to_stop`` exactly when a path was found within the time
+  budget (NaN otherwise: no path, or one found after the time budget, applied after the
+  run); each convergence time NaN or within 0 .. ``time_to_stop``.
 """
 
 from __future__ import annotations
@@ -111,6 +114,10 @@ def _key_rules(t: pd.DataFrame, d: Design):
 
     yield "stop is a stop rule", ~t["stop"].isin(STOPS)
     yield "stop_reason is solved, max_iterations or max_seconds", ~t["stop_reason"].isin(REASONS)
+    run = t["run_stop_reason"]
+    yield "run_stop_reason is solved, max_iterations or max_seconds", ~run.isin(REASONS)
+    yield ("run_stop_reason equals stop_reason unless the time budget stopped the run",
+           (run != t["stop_reason"]) & (t["stop_reason"] != "max_seconds"))  # fmt: skip
     planners = {}
     for text in t["key"].unique():
         try:
@@ -182,8 +189,10 @@ def _time_rules(t: pd.DataFrame):
     first, found = t["time_to_first"].to_numpy(), np.isfinite(t["cost"].to_numpy())
     yield "time_to_stop is finite and >= 0", ~(np.isfinite(stop) & (stop >= 0))
     yield "setup_time is finite and >= 0", ~(np.isfinite(setup) & (setup >= 0))
+    late = (t["stop_reason"] == "max_seconds").to_numpy()  # a path may come after the budget
     ok_first = np.isfinite(first) & (first >= 0) & (first <= stop + TIME_SLACK)
-    yield "time_to_first is in 0..time_to_stop when a path was found", found & ~ok_first
+    yield ("time_to_first is in 0..time_to_stop when a path was found (within the time budget)",
+           found & ~ok_first & ~(late & np.isnan(first)))  # fmt: skip
     yield "time_to_first is NaN when no path was found", ~found & ~np.isnan(first)
     for col in CONVERGENCE_COLUMNS:
         v = t[col].to_numpy()

@@ -8,7 +8,7 @@ digest is the sha256 of, per job in order: the instance (every field of
 job's key, stop rule, trial range and regime cell, the planner settings the job runs with
 (:func:`run_settings`: the cell's settings with the key's informed flag and tau, less what
 its run does not read), the heatmap
-settings (:class:`~vnrrt.evaluation.trials.HeatSettings`), the global seed (the trials'
+settings (:class:`~vnrrt.evaluation.trials.TrialSettings`), the global seed (the trials'
 seeds derive from it and the instance index), and the source of the code that plans and
 measures (:func:`code_digest`). A configuration with the same digest ran the same trials, so
 its rows are read back from ``<store>/<digest>.csv`` instead of planned again; the rows' ``seq``

@@ -31,6 +31,8 @@ from dataclasses import asdict, dataclass
 import numpy as np
 import pandas as pd
 
+from vnrrt.evaluation.table import solved
+
 VERDICTS = (
     "reproduced",
     "same direction, smaller effect",
@@ -188,8 +190,8 @@ def _paired(base: pd.DataFrame, plan: pd.DataFrame, metric: str) -> dict[str, np
     its cost: a comparison is made hundreds of times per report)."""
     keys = ["instance", "trial"]
     cols = [*keys, "cluster", metric, "success"]
-    b, p = ({c: v.to_numpy() for c, v in t[cols].sort_values(keys, kind="stable").items()}
-            for t in (base, plan))  # fmt: skip
+    b, p = ({c: v.to_numpy() for c, v in _with_success(t, metric)[cols]
+             .sort_values(keys, kind="stable").items()} for t in (base, plan))  # fmt: skip
     same = len(b["trial"]) == len(p["trial"]) and all(np.array_equal(b[k], p[k]) for k in keys)
     if not same or pd.MultiIndex.from_arrays([b[k] for k in keys]).has_duplicates:
         raise ValueError(
@@ -198,6 +200,11 @@ def _paired(base: pd.DataFrame, plan: pd.DataFrame, metric: str) -> dict[str, np
         )
     rest = {f"{c}{s}": t[c] for c in cols[2:] for s, t in (("_b", b), ("_p", p))}
     return {"instance": b["instance"], "trial": b["trial"], **rest}
+
+
+def _with_success(t: pd.DataFrame, metric: str) -> pd.DataFrame:
+    """``t`` with ``success`` as ``metric``'s reading counts it (:func:`.table.solved`)."""
+    return t.assign(success=solved(t, metric)) if metric == "iterations" else t
 
 
 def compare(

@@ -48,7 +48,7 @@ class TrialRow:
     trial: int
     seed: int
     success: bool  # stop rule met within the budgets
-    stop_reason: str  # solved | max_iterations | max_seconds
+    stop_reason: str  # solved | max_iterations | max_seconds (the time budget, after the run)
     fallback_uniform: bool  # the heatmap had no weight left (M-VNRRT* above tau): uniform
     reference_length: float  # A* length (initial, optimal) or exact optimum (optimal_any_angle)
     cost: float  # length of the best path found (inf: none)
@@ -73,6 +73,10 @@ class TrialRow:
     # the training seed (train.seed) of the network whose heatmap the sampler draws from; -1:
     # none (RRT*, oracles), a network trained elsewhere, or a table written before the column
     network_seed: int = -1
+    # how the run itself stopped (its wall-clock cap eval.cap_factor x the time budget, which
+    # ``stop_reason`` applies after the run): what the iteration readings see (:func:`solved`);
+    # '' in a table written before the column: read as ``stop_reason``
+    run_stop_reason: str = ""
 
     def record(self) -> dict:
         """The row as ``{column: value}`` (convergence times as ``t_<f>x`` columns)."""
@@ -110,10 +114,15 @@ def frame(rows: list[TrialRow]) -> pd.DataFrame:
 def conform(table: pd.DataFrame, where: str) -> pd.DataFrame:
     """``table`` with exactly :data:`COLUMNS` in order and their dtypes; :class:`TableError`
     naming ``where`` if a column is missing (the :data:`REPEAT_COLUMNS`, absent from tables
-    written before they existed, read as NaN: not repeated; ``network_seed`` as -1)."""
+    written before they existed, read as NaN: not repeated; ``network_seed`` as -1;
+    ``run_stop_reason`` as ``stop_reason``: the run stopped at the time budget)."""
     table = table.assign(**{c: math.nan for c in REPEAT_COLUMNS if c not in table.columns})
     seeds = table["network_seed"] if "network_seed" in table.columns else -1
     table = table.assign(network_seed=pd.Series(seeds, index=table.index).fillna(-1))
+    if "stop_reason" in table.columns:  # run_stop_reason absent or '': the stop_reason
+        run = table["run_stop_reason"] if "run_stop_reason" in table.columns else ""
+        run = pd.Series(run, index=table.index, dtype=object).fillna("").astype(str)
+        table = table.assign(run_stop_reason=run.where(run != "", table["stop_reason"]))
     missing = [c for c in COLUMNS if c not in table.columns]
     if missing:
         raise TableError(f"trial table {where} lacks columns {missing} (re-run the trials)")
@@ -124,6 +133,16 @@ def conform(table: pd.DataFrame, where: str) -> pd.DataFrame:
         else:
             out[col] = out[col].astype(dtype)
     return out
+
+
+def solved(table: pd.DataFrame, metric: str) -> pd.Series:
+    """Which runs of ``table`` met the stop rule within the budget that bounds ``metric``'s
+    reading: for ``iterations`` the iteration budget (the run's own stop, ``run_stop_reason``:
+    a time budget applied after the run does not cut its iterations), for every other metric
+    both budgets (``success``; also where a table has no ``run_stop_reason``)."""
+    if metric == "iterations" and "run_stop_reason" in table.columns:
+        return table["run_stop_reason"] == "solved"
+    return table["success"]
 
 
 def with_network_seeds(table: pd.DataFrame, seeds: dict[str, int]) -> pd.DataFrame:

@@ -31,20 +31,22 @@ from vnrrt.evaluation.protocol import TrialJob, timed_twice, trial_jobs, trial_s
 from vnrrt.evaluation.sampling import build_sampler, free_rule
 from vnrrt.evaluation.table import CONVERGENCE_FACTORS, TrialRow, conform, frame
 from vnrrt.infra.parallel import parallel_map
-from vnrrt.planners import PlannerConfig, plan, warmup
+from vnrrt.planners import PlannerConfig, PlanResult, plan, warmup
 
 log = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True)
-class HeatSettings:
-    """How heatmaps are measured and oracle heatmaps built: ``radius`` (px) of "mass near the
-    target" (``oracle.radius``), the start/goal disks' ``endpoint_radius`` (px,
-    ``eval.endpoint_radius``: the ``noends`` mask and the mass shares), the target of each
-    trained network (``'path'`` or ``'interior_vertices'``), and the oracles' blur ``sigma``
-    (px) and uniform ``floor`` (``oracle.sigma``, ``oracle.floor``; None where a stage samples
-    no oracle), and the default obstacle rule (``eval.zero_obstacles``; a key's ``+free``
-    flips it: :mod:`vnrrt.evaluation.sampling`)."""
+class TrialSettings:
+    """How a stage's trials run, beside the planner settings: how heatmaps are measured and
+    oracle heatmaps built (``radius`` (px) of "mass near the target", ``oracle.radius``; the
+    start/goal disks' ``endpoint_radius`` (px, ``eval.endpoint_radius``: the ``noends`` mask
+    and the mass shares); the target of each trained network (``'path'`` or
+    ``'interior_vertices'``); the oracles' blur ``sigma`` (px) and uniform ``floor``
+    (``oracle.sigma``, ``oracle.floor``; None where a stage samples no oracle)), the default
+    obstacle rule (``eval.zero_obstacles``; a key's ``+free`` flips it:
+    :mod:`vnrrt.evaluation.sampling`) and each run's wall-clock cap, ``cap_factor`` x the
+    time budget (``eval.cap_factor``; :func:`time_reading`)."""
 
     radius: float
     endpoint_radius: float
@@ -52,9 +54,28 @@ class HeatSettings:
     sigma: float | None = None
     floor: float | None = None
     zero_obstacles: bool = False  # the default obstacle rule (eval.zero_obstacles)
+    cap_factor: float = 1.0  # a run's wall-clock cap, x planner.max_seconds (eval.cap_factor)
 
 
-def _row(job, inst, trial, seed, result, setup, ref, measured) -> TrialRow:
+def time_reading(result: PlanResult, budget: float) -> dict:
+    """The row fields of a run, made with a wall-clock cap above the time budget ``budget``
+    (s), that the time readings see: the run as if the budget had stopped it. A run still
+    going after ``budget`` s counts as stopped there (``success`` False, ``stop_reason``
+    ``max_seconds``, ``time_to_stop`` = ``budget``), and a first solution or a convergence
+    bound reached after it as not reached (NaN). Iterations, costs and ``run_stop_reason``
+    stay the run's: the iteration readings see it stopped by the iteration budget only."""
+    times = tuple(m.time for m in result.milestones)
+    if result.time_to_stop <= budget:
+        return {"success": result.success, "stop_reason": result.stop_reason,
+                "time_to_first": result.time_to_first, "time_to_stop": result.time_to_stop,
+                "convergence": times}  # fmt: skip
+    first = result.time_to_first if result.time_to_first <= budget else math.nan
+    return {"success": False, "stop_reason": "max_seconds", "time_to_first": first,
+            "time_to_stop": budget, "convergence": tuple(t if t <= budget else math.nan
+                                                        for t in times)}  # fmt: skip
+
+
+def _row(job, inst, trial, seed, result, setup, ref, measured, budget) -> TrialRow:
     key = job.key
     return TrialRow(
         seq=job.seq + trial - job.first,
@@ -69,19 +90,16 @@ def _row(job, inst, trial, seed, result, setup, ref, measured) -> TrialRow:
         stop=job.stop,
         trial=trial,
         seed=seed,
-        success=result.success,
-        stop_reason=result.stop_reason,
+        run_stop_reason=result.stop_reason,
         fallback_uniform=result.fallback_uniform,
         reference_length=ref,
         cost=result.cost,
         iterations=result.iterations,
         tree_size=result.tree_size,
         collision_checks=result.collision_checks,
-        time_to_first=result.time_to_first,
-        time_to_stop=result.time_to_stop,
         setup_time=setup,
-        convergence=tuple(m.time for m in result.milestones),
         regime=job.regime,
+        **time_reading(result, budget),
         **measured,
     )
 
@@ -90,12 +108,14 @@ def run_job(
     args: tuple[TrialJob, EvalInstance],
     seed: int,
     configs: dict[str, PlannerConfig],
-    heat: HeatSettings,
+    heat: TrialSettings,
 ) -> list[TrialRow]:
     """The rows of one job on its instance (``args``: the job and its instance);
     ``configs`` holds the planner settings of each regime cell (``''``: the protocol's)."""
     job, inst = args
     key, stop, config = job.key, job.stop, reuse.job_config(job, configs)
+    budget = config.max_seconds  # the time readings' budget; the run's cap heat.cap_factor x
+    config = config.replace(max_seconds=budget * heat.cap_factor)
     warmup()
     free = free_rule(key, heat.zero_obstacles)
     allowed = sources.allowed_cells(inst.grid, free)
@@ -125,12 +145,12 @@ def run_job(
             config=config,
         )
         r = dataclasses.replace(r, fallback_uniform=r.fallback_uniform or fallback)
-        rows.append(_row(job, inst, trial, s, r, setup, ref, measured))
+        rows.append(_row(job, inst, trial, s, r, setup, ref, measured, budget))
     return rows
 
 
 def _measure(key: ConfigKey, heatmap: np.ndarray, allowed: np.ndarray, inst: EvalInstance,
-             heat: HeatSettings) -> dict:  # fmt: skip
+             heat: TrialSettings) -> dict:  # fmt: skip
     """What a configuration's heatmap is worth: its mass near its target (``heat_mass``), a
     uniform map's over the allowed cells (``uniform_mass``), and where the sampler's weights
     lie after the mask (:func:`vnrrt.evaluation.sources.mass_shares`)."""
@@ -198,7 +218,7 @@ def run_jobs(
     seed: int,
     workers: int,
     config: PlannerConfig | dict[str, PlannerConfig],
-    heat: HeatSettings,
+    heat: TrialSettings,
     store: str | Path | None = None,
     repeat: bool = False,
 ) -> pd.DataFrame:
@@ -239,15 +259,16 @@ def run_trials(
     seed: int = 0,
     workers: int = 0,
     config: PlannerConfig | None = None,
-    heat: HeatSettings | None = None,
+    heat: TrialSettings | None = None,
 ) -> pd.DataFrame:
     """All trials of ``keys`` on ``instances`` (protocol order) as a table, for library
     callers; ``counts[(kind, stop)]`` trials per instance, kind ``'named'`` or ``'random'``;
     ``config``/``heat`` default to the library's :class:`PlannerConfig` and
-    :data:`LIBRARY_HEAT` (the pipeline passes its config's, :func:`run_jobs`)."""
+    :data:`LIBRARY_SETTINGS` (the pipeline passes its config's, :func:`run_jobs`)."""
     jobs = trial_jobs([inst.kind for inst in instances], keys, counts)
     by_index = dict(enumerate(instances))
-    return run_jobs(jobs, by_index, seed, workers, config or PlannerConfig(), heat or LIBRARY_HEAT)
+    settings = heat or LIBRARY_SETTINGS
+    return run_jobs(jobs, by_index, seed, workers, config or PlannerConfig(), settings)
 
 
-LIBRARY_HEAT = HeatSettings(3.0, 3.0, {}, sigma=1.0, floor=0.0)  # conf/oracle's, conf/eval's
+LIBRARY_SETTINGS = TrialSettings(3.0, 3.0, {}, sigma=1.0, floor=0.0)  # conf/oracle's, conf/eval's

@@ -20,6 +20,7 @@ from omegaconf import DictConfig
 
 from vnrrt.config import ConfigError, sections
 from vnrrt.config.paths import Paths
+from vnrrt.evaluation.config import check_cap_factor
 
 log = logging.getLogger(__name__)
 
@@ -39,6 +40,7 @@ def bench_settings(cfg: DictConfig) -> dict:
             "sources": {str(k): str(v) for k, v in ev.sources.items()},
             "endpoint_radius": float(ev.endpoint_radius),
             "zero_obstacles": bool(ev.zero_obstacles),
+            "cap_factor": check_cap_factor(ev.cap_factor),
         },
         "oracle": {"radius": float(oc.radius), "floor": float(oc.floor)},
         "labels": {"tie_break": str(cfg.labels.tie_break)},
@@ -96,19 +98,20 @@ def add_heatmaps(instances: dict, networks: list[str], paths: Paths) -> tuple[di
 def bench_trials(s: dict, instances: dict, keys: list, targets: dict):
     """The trial table of ``keys`` on ``instances`` (reusing the kept rows of unchanged
     configurations, :mod:`vnrrt.evaluation.reuse`)."""
-    from vnrrt.evaluation.trials import HeatSettings, run_jobs
+    from vnrrt.evaluation.trials import TrialSettings, run_jobs
     from vnrrt.studies.benchmark_maps.design import jobs
 
     ev, bm = s["eval"], s["bench_maps"]
     todo = jobs(len(instances), keys, bm.trials)
     log.info("benchmark maps: %d trial jobs on %d queries", len(todo), len(instances))
-    heat = HeatSettings(
+    heat = TrialSettings(
         s["oracle"]["radius"],
         ev["endpoint_radius"],
         targets,
         None,
         s["oracle"]["floor"],
         ev["zero_obstacles"],
+        ev["cap_factor"],
     )
     store = s["paths"].reuse_store("bench_maps")
     return run_jobs(todo, instances, s["seed"], s["workers"], s["planner"], heat, store)

@@ -91,7 +91,7 @@ def run_trials_part(cfg: DictConfig, part: int) -> int:
         trial_jobs,
     )
     from vnrrt.evaluation.table import with_network_seeds, write_table
-    from vnrrt.evaluation.trials import HeatSettings, run_jobs
+    from vnrrt.evaluation.trials import TrialSettings, run_jobs
 
     s = trials_settings(cfg)
     paths, ev, planner = s["paths"], s["eval"], s["planner"]
@@ -110,8 +110,8 @@ def run_trials_part(cfg: DictConfig, part: int) -> int:
     log.info(
         "part %d/%d: %d trial jobs on %d instances", part, len(ev.parts), len(jobs), len(instances)
     )
-    heat = HeatSettings(s["oracle"]["radius"], ev.endpoint_radius, targets,
-                        zero_obstacles=ev.zero_obstacles)  # fmt: skip
+    heat = TrialSettings(s["oracle"]["radius"], ev.endpoint_radius, targets,
+                         zero_obstacles=ev.zero_obstacles, cap_factor=ev.cap_factor)  # fmt: skip
     store = paths.reuse_store("trials")
     table = run_jobs(jobs, instances, s["seed"], s["workers"], planner, heat, store,
                      ev.timing_noise)  # fmt: skip

@@ -39,9 +39,10 @@ BUNDLE = {  # file -> what it holds
 }
 LATER_SECTIONS = ("bench_maps",)  # sections a bundle may predate: no recomputed stage reads them
 # settings a bundle may predate, at the value its run had in effect (RRT* timed once; fixed
-# budgets; NRRT* sampling the path oracles, VNRRT* the others; the protocol cell's selection)
+# budgets; NRRT* sampling the path oracles, VNRRT* the others; the protocol cell's selection;
+# runs stopped at the time budget)
 LATER_SETTINGS = {"eval.timing_noise": False, "planner.iterations_per_free_cell": None,
-                  "planner.seconds_per_free_cell": None,
+                  "planner.seconds_per_free_cell": None, "eval.cap_factor": 1.0,
                   "oracle.planners": {"path": "nrrt_star"}, "oracle.per_cell": False}  # fmt: skip
 _ABSENT = object()
 MACHINE = "machine.json"  # optional: {"machine": the CPU whose timings the tables hold}

@@ -21,7 +21,13 @@ from omegaconf import DictConfig
 
 from vnrrt.config import ConfigError, check_parts, conf_defaults, section, sections
 from vnrrt.config.paths import Paths
-from vnrrt.evaluation.config import Configurations, OracleConfig, RegimeConfig, RegimeGrid, Rules
+from vnrrt.evaluation.config import (
+    Configurations,
+    OracleConfig,
+    RegimeConfig,
+    RegimeGrid,
+    Rules,
+)
 
 log = logging.getLogger(__name__)
 
@@ -167,14 +173,15 @@ def _run(s: dict, jobs: list, configs: dict, out: Path, networks: list[str], sta
     the kept rows of stage ``stage``'s unchanged configurations."""
     from vnrrt.data.instances import load
     from vnrrt.evaluation.table import with_network_seeds, write_table
-    from vnrrt.evaluation.trials import HeatSettings, run_jobs
+    from vnrrt.evaluation.trials import TrialSettings, run_jobs
 
     st = _study(s)
     parts = s.get("predict", {}).get("parts", [0])
     indices = sorted({job.instance for job in jobs})
     instances, targets = load(st.paths.instances, indices, networks, st.paths.heatmaps, parts)
     oc, ev = st.oracle, st.ev
-    heat = HeatSettings(oc.radius, ev.endpoint_radius, targets, None, oc.floor, ev.zero_obstacles)
+    heat = TrialSettings(oc.radius, ev.endpoint_radius, targets, None, oc.floor, ev.zero_obstacles,
+                         ev.cap_factor)  # fmt: skip
     store = st.paths.reuse_store(stage)
     table = run_jobs(jobs, instances, s["seed"], s["workers"], configs, heat, store)
     seed = s.get("train", {}).get("seed", -1)

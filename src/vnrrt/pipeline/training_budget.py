@@ -70,6 +70,8 @@ def run_budget_predict(cfg: DictConfig, steps: int, seed: int) -> dict:
 
 def _design(cfg: DictConfig) -> dict:
     """The ``eval`` keys of :class:`~vnrrt.studies.training_budget.design.BudgetTrials`, typed."""
+    from vnrrt.evaluation.config import check_cap_factor
+
     ev = cfg.eval
     return {
         "planners": [str(p) for p in ev.planners],
@@ -79,6 +81,7 @@ def _design(cfg: DictConfig) -> dict:
         "any_angle": bool(ev.any_angle),
         "endpoint_radius": float(ev.endpoint_radius),
         "zero_obstacles": bool(ev.zero_obstacles),
+        "cap_factor": check_cap_factor(ev.cap_factor),
     }
 
 
@@ -98,7 +101,7 @@ def run_budget_trials(cfg: DictConfig, steps: int, seed: int) -> int:
     """Stage ``budget_trials@<steps>-<seed>`` (module doc); returns the number of trials."""
     from vnrrt.data.instances import Instances, load
     from vnrrt.evaluation.table import with_network_seeds, write_table
-    from vnrrt.evaluation.trials import HeatSettings, run_jobs
+    from vnrrt.evaluation.trials import TrialSettings, run_jobs
     from vnrrt.studies.training_budget.design import BudgetTrials
 
     s = trials_settings(cfg)
@@ -110,8 +113,9 @@ def run_budget_trials(cfg: DictConfig, steps: int, seed: int) -> int:
     instances, targets = load(paths.instances, indices, networks, heatmaps, [0])
     log.info("budget %d, seed %d: %d trial jobs on %d instances", steps, seed, len(jobs),
              len(instances))  # fmt: skip
-    heat = HeatSettings(s["oracle"]["radius"], design.endpoint_radius, targets,
-                        zero_obstacles=design.zero_obstacles)  # fmt: skip
+    heat = TrialSettings(s["oracle"]["radius"], design.endpoint_radius, targets,
+                         zero_obstacles=design.zero_obstacles,
+                         cap_factor=design.cap_factor)  # fmt: skip
     store = paths.reuse_store("budget_trials")
     table = run_jobs(jobs, instances, s["seed"], s["workers"], planner, heat, store)
     table = with_network_seeds(table, dict.fromkeys(networks, int(seed)))

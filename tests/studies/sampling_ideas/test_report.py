@@ -49,14 +49,18 @@ def test_only_cells_with_runs_stopped_by_the_budget_are_listed():
         ("eta=inf", "vnrrt_star"): 0.5,
     }
     summary = _summary({}, success)
-    for row in summary["cells"]:  # 3 runs of one configuration cut by the time budget
-        row["cut_by_time"] = (
-            3 if (row["regime"], row["configuration"]) == ("eta=10", "nrrt_star") else 0
-        )
+    for row in summary["cells"]:  # 3 runs of one configuration over the time budget, 1 capped
+        hit = (row["regime"], row["configuration"]) == ("eta=10", "nrrt_star")
+        row["cut_by_time"], row["cut_by_cap"] = (3, 1) if hit else (0, 0)
     got = censored_cells(summary, "optimal")
-    assert got == [("eta=10", 0.9, 0.75, "nrrt_star", 3), ("eta=inf", 1.0, 0.5, "vnrrt_star", 0)]
+    assert got == [("eta=10", 0.9, 0.75, "nrrt_star", 3, 1),
+                   ("eta=inf", 1.0, 0.5, "vnrrt_star", 0, 0)]  # fmt: skip
     table = budget_table(summary, "optimal")
-    assert "| eta=10 | 90.0% | 75.0% | NRRT* | 3 |" in table and "protocol" not in table
-    assert "(3 in all)" in table and "| eta=inf | 100.0% | 50.0% | VNRRT* | 0 |" in table
+    assert "| eta=10 | 90.0% | 75.0% | NRRT* | 3 | 1 |" in table and "protocol" not in table
+    assert "3 runs over every" in table and "(the last column, 1 in all)" in table
+    assert "| eta=inf | 100.0% | 50.0% | VNRRT* | 0 | 0 |" in table
+    for row in summary["cells"]:  # a summary written before the cap: its time budget was it
+        del row["cut_by_cap"]
+    assert censored_cells(summary, "optimal")[0][4:] == (3, 3)
     clean = {k: 1.0 for k in success}
     assert budget_table(_summary({}, clean), "optimal").startswith("Every run")

@@ -15,7 +15,7 @@ from vnrrt.evaluation.noise import timing_noise
 from vnrrt.evaluation.protocol import STOPS
 from vnrrt.evaluation.stats import Summary, compare, summarize
 from vnrrt.evaluation.strata import assign, mix
-from vnrrt.evaluation.table import CONVERGENCE_COLUMNS, CONVERGENCE_FACTORS
+from vnrrt.evaluation.table import CONVERGENCE_COLUMNS, CONVERGENCE_FACTORS, solved
 from vnrrt.studies.paper_comparison.claims import claims, mask_shares
 
 METRICS = {"time_to_stop": True, "iterations": True, "cost": False}  # metric -> censored
@@ -24,7 +24,7 @@ METRICS = {"time_to_stop": True, "iterations": True, "cost": False}  # metric ->
 def _summary(sub: pd.DataFrame, metric: str, n_boot: int, level: float) -> Summary:
     return summarize(
         sub[metric],
-        sub["success"],
+        solved(sub, metric),
         sub["cluster"],
         sub["fallback_uniform"],
         censor=METRICS[metric],

@@ -54,6 +54,7 @@ def cell_rows(table: pd.DataFrame, boot: tuple) -> list[dict]:
             "source": str(rows["source"].iloc[0]),
             "success_rate": float(rows["success"].mean()),
             "cut_by_time": int((rows["stop_reason"] == "max_seconds").sum()),
+            "cut_by_cap": int((rows["run_stop_reason"] == "max_seconds").sum()),
             "median_ms": float(1e3 * rows["time_to_stop"].median()),
             "median_iterations": float(rows["iterations"].median()),
             "heat_mass": _mean(rows["heat_mass"]),

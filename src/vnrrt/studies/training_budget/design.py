@@ -30,6 +30,7 @@ class BudgetTrials:
     any_angle: bool
     endpoint_radius: float
     zero_obstacles: bool
+    cap_factor: float  # a run's wall-clock cap, x planner.max_seconds (eval.cap_factor)
 
     def keys(self, tau: float) -> list[ConfigKey]:
         """The configurations, in the protocol's order (``rrt_star``, ``nrrt_star``,
@@ -37,7 +38,8 @@ class BudgetTrials:
         ev = Configurations(list(self.planners), dict(self.sources), informed=False,
                             mask_variants=[], masked_controls=False,
                             endpoint_radius=self.endpoint_radius,
-                            zero_obstacles=self.zero_obstacles)  # fmt: skip
+                            zero_obstacles=self.zero_obstacles,
+                            cap_factor=self.cap_factor)  # fmt: skip
         return configurations(ev, [tau], tau)
 
     def counts(self) -> dict[tuple[str, str], int]:

@@ -19,6 +19,7 @@ import numpy as np
 import pandas as pd
 
 from vnrrt.evaluation.seeds import seed_compare
+from vnrrt.evaluation.table import solved
 from vnrrt.studies.training_budget.summary import (
     BASELINE,
     CONTROL,
@@ -40,6 +41,7 @@ def paired_rows(inputs: list[dict], base: str, plan: str, stop: str, metric: str
     for inp in inputs:
         t = inp["trials"]
         t = t[(t["map_set"] == "random") & (t["stop"] == stop)]
+        t = t.assign(success=solved(t, metric))  # as the metric's reading counts a success
         cols = [*BY, "cluster", metric, "success"]
         b = t[t["key"] == base][cols].rename(columns={metric: "base", "success": "base_ok"})
         p = t[t["key"] == plan][[*BY, metric, "success"]]
