@@ -9,7 +9,8 @@ from vnrrt.evaluation.config import StatsConfig
 from vnrrt.evaluation.table import COLUMNS, conform
 from vnrrt.studies.paper_comparison.networks_report import MetricSettings, networks_section
 from vnrrt.studies.paper_comparison.paper_noise import ratio_interval
-from vnrrt.studies.paper_comparison.report import ReportInputs, build_report, cell
+from vnrrt.studies.paper_comparison.report import ReportInputs, build_report
+from vnrrt.studies.paper_comparison.tables import cell
 from vnrrt.studies.paper_comparison.summary import analyze
 from vnrrt.studies.paper_tables import load_paper_tables
 
