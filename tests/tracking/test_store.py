@@ -22,6 +22,7 @@ from mlflow import MlflowClient
 
 from tests.train_helpers import small_cfg
 from vnrrt.pipeline.training import run_train
+from vnrrt.tracking import experiments
 from vnrrt.tracking import store as tracking
 
 
@@ -72,18 +73,18 @@ def test_git_commit_is_read_from_the_git_files(tmp_path):
     git = tmp_path / ".git"
     (git / "refs" / "heads").mkdir(parents=True)
     (git / "HEAD").write_text("ref: refs/heads/main\n")
-    assert tracking.git_commit(tmp_path) == "unknown"  # no such ref yet
+    assert experiments.git_commit(tmp_path) == "unknown"  # no such ref yet
     (git / "packed-refs").write_text("# pack-refs\n" + "a" * 40 + " refs/heads/main\n")
-    assert tracking.git_commit(tmp_path) == "a" * 40
+    assert experiments.git_commit(tmp_path) == "a" * 40
     (git / "refs" / "heads" / "main").write_text("b" * 40 + "\n")
-    assert tracking.git_commit(tmp_path) == "b" * 40
+    assert experiments.git_commit(tmp_path) == "b" * 40
     (git / "HEAD").write_text("c" * 40 + "\n")  # detached
-    assert tracking.git_commit(tmp_path) == "c" * 40
-    assert tracking.git_commit(tmp_path / "nothing") == "unknown"
+    assert experiments.git_commit(tmp_path) == "c" * 40
+    assert experiments.git_commit(tmp_path / "nothing") == "unknown"
 
 
 def test_params_are_flat_text_with_one_spelling_of_booleans_and_nulls():
-    flat = tracking.flat_params({"a": {"b": [1, True], "c": None, "d": {"e": 0.5, "f": False}}})
+    flat = experiments.flat_params({"a": {"b": [1, True], "c": None, "d": {"e": 0.5, "f": False}}})
     assert flat == {"a.b": "1,true", "a.c": "null", "a.d.e": "0.5", "a.d.f": "false"}
 
 
@@ -112,7 +113,7 @@ def test_a_training_run_is_recorded_in_mlflow(small_data, tmp_path, monkeypatch)
     assert tags["dvc_stage"] == "train@vertexnet" and tags["dvc_experiment"] == "tidy-exp"
     assert tags["kind"] == "vertexnet" and tags["scale"] == "smoke"
     assert tags["checkpoint_sha256"] == metrics["checkpoint_sha256"]
-    assert tags["git_commit"] == tracking.git_commit(Path(__file__).resolve().parents[2])
+    assert tags["git_commit"] == experiments.git_commit(Path(__file__).resolve().parents[2])
     params = run.data.params
     assert params["model.net.encoder"] == "resnet18" and params["network.target"] == "vertex"
     assert params["train.datamodule.batch_size"] == str(cfg.train.datamodule.batch_size)
@@ -294,7 +295,7 @@ def test_only_runs_whose_process_is_gone_are_marked_killed(tmp_path):
     uri = f"sqlite:///{tmp_path / 'mlflow.db'}"
     exp = tracking.experiment_id("vnrrt-smoke", uri)
     client = MlflowClient(uri)
-    tags = tracking.run_tags("evaluation", "smoke")
+    tags = experiments.run_tags("evaluation", "smoke")
     alive = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"])
     try:
         extras = {
@@ -305,7 +306,7 @@ def test_only_runs_whose_process_is_gone_are_marked_killed(tmp_path):
         runs = {
             n: client.create_run(exp, tags={**tags, **e}).info.run_id for n, e in extras.items()
         }
-        marked = tracking.mark_stale_runs(uri, exp, tags)
+        marked = experiments.mark_stale_runs(uri, exp, tags)
     finally:
         alive.kill()
         alive.wait()
@@ -321,12 +322,12 @@ def test_open_experiment_closes_a_killed_evaluation_and_its_nested_runs(tmp_path
     logger = SimpleNamespace(uri=uri, experiment="vnrrt-smoke", artifact_location=None)
     exp = tracking.experiment_id("vnrrt-smoke", uri)
     client = MlflowClient(uri)
-    old = {**tracking.run_tags("evaluation", "smoke"), "pid": dead_pid()}
+    old = {**experiments.run_tags("evaluation", "smoke"), "pid": dead_pid()}
     parent = client.create_run(exp, tags=old).info.run_id
     nested = client.create_run(exp, tags={**old, "planner": "rrt_star",
                                           "mlflow.parentRunId": parent}).info.run_id  # fmt: skip
     ideas = client.create_run(exp, tags={**old, "kind": "ideas"}).info.run_id  # another stage
-    got_uri, got_exp, tags = tracking.open_experiment(logger, "evaluation", "smoke")
+    got_uri, got_exp, tags = experiments.open_experiment(logger, "evaluation", "smoke")
     assert (got_uri, got_exp) == (uri, exp) and tags["pid"] == str(os.getpid())
     assert tags["host"] == socket.gethostname() and tags["kind"] == "evaluation"
     status = {r: client.get_run(r).info.status for r in (parent, nested, ideas)}

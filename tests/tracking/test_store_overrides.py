@@ -2,7 +2,7 @@
 run's params.yaml that differ from conf/'s default composition at its scale."""
 
 from vnrrt.config import compose, dump
-from vnrrt.tracking.store import override_text, overrides, run_name, run_tags
+from vnrrt.tracking.experiments import override_text, overrides, run_name, run_tags
 
 
 def params(tmp_path, over: list[str]):

@@ -110,6 +110,7 @@ def test_stale_running_runs_of_the_stage_are_marked_killed(small_data, tmp_path,
     """A SIGKILLed training cannot end its MLflow run; the next run of that stage does."""
     from mlflow import MlflowClient
 
+    from vnrrt.tracking import experiments
     from vnrrt.tracking import store as tracking
 
     monkeypatch.setenv("DVC_STAGE", "train@vertexnet")
@@ -117,8 +118,8 @@ def test_stale_running_runs_of_the_stage_are_marked_killed(small_data, tmp_path,
     uri = f"sqlite:///{tmp_path}/mlflow.db"
     exp = tracking.experiment_id(cfg.logger.experiment, uri)
     client = MlflowClient(uri)
-    stale = client.create_run(exp, tags=tracking.run_tags("vertexnet", "smoke"))
-    other = client.create_run(exp, tags=tracking.run_tags("nrrtnet", "smoke"))
+    stale = client.create_run(exp, tags=experiments.run_tags("vertexnet", "smoke"))
+    other = client.create_run(exp, tags=experiments.run_tags("nrrtnet", "smoke"))
     train(cfg, "vertexnet")
     assert client.get_run(stale.info.run_id).info.status == "KILLED"
     assert client.get_run(other.info.run_id).info.status == "RUNNING"  # another stage's

@@ -30,7 +30,7 @@ def bench_settings(cfg: DictConfig) -> dict:
     from vnrrt.evaluation.config import StatsConfig
     from vnrrt.planners.config import PlannerConfig
     from vnrrt.studies.benchmark_maps.config import BenchMapsConfig
-    from vnrrt.tracking.store import LoggerConfig
+    from vnrrt.tracking.experiments import LoggerConfig
 
     typed = sections(cfg, paths=Paths, planner=PlannerConfig, bench_maps=BenchMapsConfig)
     typed |= sections(cfg, stats=StatsConfig, logger=LoggerConfig)

@@ -94,7 +94,7 @@ def report_settings(cfg: DictConfig) -> dict:
     value of every setting the settings table names (``paths.paper_settings``)."""
     from vnrrt.evaluation.config import EvalConfig
     from vnrrt.planners.config import PlannerConfig
-    from vnrrt.tracking.store import LoggerConfig
+    from vnrrt.tracking.experiments import LoggerConfig
 
     typed = sections(cfg, paths=Paths, eval=EvalConfig, planner=PlannerConfig)
     typed |= sections(cfg, logger=LoggerConfig) | {"scale": {"name": str(cfg.scale.name)}}
@@ -145,7 +145,7 @@ def against_default(paths: Paths, summary: dict, params: str = "params.yaml"):
     nothing: ``(None, "")``; so does an ablation run before any default run."""
     from vnrrt.evaluation.noise import baseline_record, changes
     from vnrrt.infra.io import read_json, write_json
-    from vnrrt.tracking.store import override_text, overrides
+    from vnrrt.tracking.experiments import override_text, overrides
 
     changed, rows = overrides(params), summary["claims"]["rows"]
     if not changed:

@@ -138,7 +138,8 @@ def run_predict_metrics(cfg: DictConfig) -> dict:
     from vnrrt.data.heatmaps import read_parts
     from vnrrt.data.instances import Instances
     from vnrrt.infra.io import read_json, write_json
-    from vnrrt.tracking.store import LoggerConfig, check_store, tracking_uri
+    from vnrrt.tracking.experiments import LoggerConfig
+    from vnrrt.tracking.store import check_store, tracking_uri
     from vnrrt.viz.evaluation import save_heatmaps
 
     paths = section(cfg, "paths", Paths)

@@ -153,7 +153,7 @@ def ideas_settings(cfg: DictConfig) -> dict:
     :func:`~vnrrt.studies.sampling_ideas.design.protocol_settings`)."""
     from vnrrt.evaluation.config import StatsConfig
     from vnrrt.studies.sampling_ideas.design import protocol_settings
-    from vnrrt.tracking.store import LoggerConfig
+    from vnrrt.tracking.experiments import LoggerConfig
 
     typed = sections(cfg, paths=Paths, eval=Configurations, oracle=OracleConfig)
     typed |= sections(cfg, regime=RegimeConfig, planner=StudyRules, stats=StatsConfig)

@@ -31,6 +31,7 @@ from omegaconf import DictConfig, OmegaConf
 
 from vnrrt.config import ConfigError, section
 from vnrrt.config.paths import Paths, TrainFiles
+from vnrrt.tracking import experiments
 from vnrrt.tracking import store as tracking
 
 log = logging.getLogger(__name__)
@@ -164,7 +165,7 @@ def fix_threads(threads: int | None) -> int:
     return torch.get_num_threads()
 
 
-def monitored_fit(logger_cfg: tracking.LoggerConfig, logger, fit_run):
+def monitored_fit(logger_cfg: experiments.LoggerConfig, logger, fit_run):
     """``fit_run()`` with the system metrics of ``logger``'s run monitored (None: not)."""
     if logger is None:
         return fit_run()
@@ -190,7 +191,7 @@ def train_network(cfg: DictConfig, network: str, files: TrainFiles,
     """Train ``network`` as ``cfg`` says into ``files`` (module doc); ``budget``: the steps
     of a budget-curve training (its MLflow run, no MLflow Model). The stage's parameters are
     read here; below, typed pieces."""
-    logger_cfg = section(cfg, "logger", tracking.LoggerConfig)
+    logger_cfg = section(cfg, "logger", experiments.LoggerConfig)
     uri = tracking.configure(logger_cfg.uri)  # before Lightning (and its MLflow logger) imports
     if logger_cfg.enabled:
         tracking.check_store(uri)  # an unreachable server fails here, before any work
@@ -254,7 +255,7 @@ def train_network(cfg: DictConfig, network: str, files: TrainFiles,
     return metrics
 
 
-def finish_run(logger_cfg: tracking.LoggerConfig, scale: str, network: str, checkpoint: Path,
+def finish_run(logger_cfg: experiments.LoggerConfig, scale: str, network: str, checkpoint: Path,
                logger, datamodule, metrics: dict, as_model: bool = True) -> dict:  # fmt: skip
     """Tag the run with the checkpoint's hash and log the test metrics once: with ``as_model``
     and ``logger.log_model`` linked to the network, logged and registered

@@ -24,7 +24,7 @@ from vnrrt.maps.config import DataConfig
 from vnrrt.planners.config import PlannerConfig
 from vnrrt.studies.benchmark_maps.config import BenchMapsConfig, map_files
 from vnrrt.studies.training_budget.budget import BudgetConfig, batches_per_epoch
-from vnrrt.tracking.store import LoggerConfig
+from vnrrt.tracking.experiments import LoggerConfig
 
 
 def _taus(planner: PlannerConfig) -> None:

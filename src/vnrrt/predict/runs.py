@@ -18,7 +18,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from vnrrt.tracking import lineage
+from vnrrt.tracking import experiments, lineage
 from vnrrt.tracking import store as tracking
 
 
@@ -32,7 +32,7 @@ def predict_metrics(out: dict) -> dict[str, float]:
             if prefix is not None:
                 tree.setdefault(places[prefix], {}).setdefault(key[len(prefix) :], {})[net] = value
         tree.setdefault("inference", {}).setdefault("ms_per_map", {})[net] = m["ms_per_map"]
-    return tracking.flat_metrics(tree)
+    return experiments.flat_metrics(tree)
 
 
 def predict_params(out: dict) -> dict[str, str]:
@@ -41,7 +41,7 @@ def predict_params(out: dict) -> dict[str, str]:
     params["planner.taus"] = out["settings"]["taus"]
     for net, m in out["networks"].items():
         params |= {f"{net}.target": m["target"], f"{net}.device": m["device"]}
-    return tracking.flat_params(params)
+    return experiments.flat_params(params)
 
 
 def named_table(shown: list) -> dict[str, list]:
@@ -56,19 +56,19 @@ def named_table(shown: list) -> dict[str, list]:
     }
 
 
-def log_predict(logger: tracking.LoggerConfig, scale: str, out: dict, files: dict[str, Path],
+def log_predict(logger: experiments.LoggerConfig, scale: str, out: dict, files: dict[str, Path],
                 trainings: dict[str, Path], shown: list) -> str:  # fmt: skip
     """The run (module doc); ``out``: what ``predict.json`` holds; ``files``: its
     ``predict.json``, ``figure`` and ``instances`` files; ``trainings``: network -> training
     metrics file; ``shown``: the named instances. Returns the run's id."""
     import mlflow
 
-    uri, exp, tags = tracking.open_experiment(logger, "predict", scale)
+    uri, exp, tags = experiments.open_experiment(logger, "predict", scale)
     client = tracking.open_store(uri)
     tags |= lineage.content_tag("predict.json", files["predict.json"])
     trained = [lineage.training_lineage(n, p) for n, p in sorted(trainings.items())]
     mlflow.set_tracking_uri(uri)
-    name = tracking.run_name(f"predict {scale}")
+    name = experiments.run_name(f"predict {scale}")
     with mlflow.start_run(experiment_id=exp, run_name=name, tags=tags) as run:
         run_id = run.info.run_id
         mlflow.log_params(predict_params(out))

@@ -27,6 +27,7 @@ from __future__ import annotations
 import logging
 from pathlib import Path
 
+from vnrrt.tracking import experiments
 from vnrrt.tracking import store as tracking
 
 log = logging.getLogger(__name__)
@@ -65,7 +66,7 @@ def run_params(settings: dict, record: dict, budget: int | None = None) -> dict:
     t = record["target"]
     network = {"target": t["kind"], "endpoints": t["endpoints"], "target_radius": t["radius"]}
     extra = {} if budget is None else {"budget": {"steps": int(budget)}}
-    flat = tracking.flat_params({**settings, "network": network, **extra})
+    flat = experiments.flat_params({**settings, "network": network, **extra})
     return {
         k: v
         for k, v in flat.items()
@@ -73,7 +74,7 @@ def run_params(settings: dict, record: dict, budget: int | None = None) -> dict:
     }
 
 
-def start_run(logger_cfg: tracking.LoggerConfig, scale: str, network: str, record: dict,
+def start_run(logger_cfg: experiments.LoggerConfig, scale: str, network: str, record: dict,
               settings: dict, config_text: str, budget: int | None = None):  # fmt: skip
     """The run's ``MLFlowLogger`` (experiment per scale, tags, :func:`run_params`, the
     parameter counts and ``config.yaml``) with the shard datasets logged as inputs;
@@ -81,11 +82,11 @@ def start_run(logger_cfg: tracking.LoggerConfig, scale: str, network: str, recor
     from hydra.utils import instantiate
 
     extra = {} if budget is None else {"budget_steps": str(int(budget))}
-    uri, _, tags = tracking.open_experiment(
+    uri, _, tags = experiments.open_experiment(
         logger_cfg, network, scale, fingerprint=record["fingerprint"], **extra
     )
     name = f"{network} {scale}" + ("" if budget is None else f" budget {int(budget)}")
-    name = tracking.run_name(name)
+    name = experiments.run_name(name)
     logger = instantiate(logger_cfg.lightning, run_name=name, tracking_uri=uri, tags=tags)
     logger.log_hyperparams(run_params(settings, record, budget))
     counts = {k: v for k, v in record["describe"].items() if k.startswith("params_")}
@@ -130,7 +131,7 @@ class SystemMetrics:
         m.mlflow_logger.flush()
 
 
-def log_model(logger_cfg: tracking.LoggerConfig, scale: str, network: str, checkpoint: Path,
+def log_model(logger_cfg: experiments.LoggerConfig, scale: str, network: str, checkpoint: Path,
               logger, example, tested: dict) -> dict:  # fmt: skip
     """Log the trained network to the run (module doc; ``example``: one input image,
     ``tested``: its test metrics) and register it; returns what the training metrics file
@@ -210,7 +211,7 @@ def describe_version(client, name: str, version: str, scale: str, record: dict, 
         "training_run": run_id,
         "checkpoint_sha256": checkpoint_sha,
         "fingerprint": record["fingerprint"],
-        "git_commit": tracking.git_commit(),
+        "git_commit": experiments.git_commit(),
     }
     for key, value in tags.items():
         client.set_model_version_tag(name, version, key, value)

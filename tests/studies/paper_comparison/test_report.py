@@ -10,8 +10,8 @@ from vnrrt.evaluation.table import COLUMNS, conform
 from vnrrt.studies.paper_comparison.networks_report import MetricSettings, networks_section
 from vnrrt.studies.paper_comparison.paper_noise import ratio_interval
 from vnrrt.studies.paper_comparison.report import ReportInputs, build_report
-from vnrrt.studies.paper_comparison.tables import cell
 from vnrrt.studies.paper_comparison.summary import analyze
+from vnrrt.studies.paper_comparison.tables import cell
 from vnrrt.studies.paper_tables import load_paper_tables
 
 METRICS = MetricSettings(radius=3.0, tau=0.5, ap_radius=1.0, endpoint_radius=3.0)

@@ -20,7 +20,7 @@ from pathlib import Path
 from vnrrt.evaluation.keys import ConfigKey
 from vnrrt.names import stop_slug
 from vnrrt.studies.benchmark_maps.design import STOP
-from vnrrt.tracking import lineage
+from vnrrt.tracking import experiments, lineage
 from vnrrt.tracking import store as tracking
 
 READ = ("speedup", "ci_low", "ci_high")
@@ -48,11 +48,11 @@ def headline_metrics(summary: dict) -> dict[str, float]:
         tree.setdefault(r["map"], {}).setdefault(stop, {})[name] = {
             m: {k: r[m][k] for k in READ} for m in ("time_to_stop", "iterations")
         }
-    return tracking.flat_metrics(tree)
+    return experiments.flat_metrics(tree)
 
 
 def log_bench_maps(
-    logger: tracking.LoggerConfig,
+    logger: experiments.LoggerConfig,
     scale: str,
     params: dict,
     summary: dict,
@@ -66,15 +66,15 @@ def log_bench_maps(
     from vnrrt.studies.benchmark_maps.report import description
     from vnrrt.tracking.report_artifacts import log_report
 
-    uri, exp, tags = tracking.open_experiment(logger, KIND, scale)
+    uri, exp, tags = experiments.open_experiment(logger, KIND, scale)
     client = tracking.open_store(uri)
     mlflow.set_tracking_uri(uri)
     extra = {}
     for path in (Path(p) for p in files if Path(p).suffix == ".json"):
         extra |= lineage.content_tag(path.name, path)
-    name = tracking.run_name(f"bench_maps {scale}")
+    name = experiments.run_name(f"bench_maps {scale}")
     with mlflow.start_run(experiment_id=exp, run_name=name, tags=tags | extra) as run:
-        mlflow.log_params(tracking.flat_params(params))
+        mlflow.log_params(experiments.flat_params(params))
         mlflow.log_metrics(headline_metrics(summary))
         log_report(client, run.info.run_id, Path(report))
         for path in files:

@@ -34,7 +34,7 @@ from vnrrt.studies.paper_comparison.claims import (
     improvement,
     verdict_text,
 )
-from vnrrt.tracking.store import metric_name
+from vnrrt.tracking.experiments import metric_name
 
 READINGS = {"time_to_stop": "planning_time", "iterations": "iterations",
             "time_total": "planning_plus_inference_time"}  # fmt: skip

@@ -29,7 +29,7 @@ from pathlib import Path
 from vnrrt.evaluation.keys import ConfigKey
 from vnrrt.names import map_set_slug, stop_slug
 from vnrrt.studies.paper_comparison import run_text
-from vnrrt.tracking import lineage
+from vnrrt.tracking import experiments, lineage
 from vnrrt.tracking import store as tracking
 
 
@@ -47,7 +47,7 @@ class EvaluationFiles:
     trainings: dict[str, Path]  # network -> its training metrics file
 
 
-def log_evaluation(logger: tracking.LoggerConfig, scale: str, params: dict,
+def log_evaluation(logger: experiments.LoggerConfig, scale: str, params: dict,
                    sources: dict[str, str], summary: dict, headline: dict,
                    files: EvaluationFiles) -> str:  # fmt: skip
     """The parent run and its nested runs (module doc; ``params``: the settings to log,
@@ -55,7 +55,7 @@ def log_evaluation(logger: tracking.LoggerConfig, scale: str, params: dict,
     parent's id."""
     import mlflow
 
-    uri, exp, tags = tracking.open_experiment(logger, "evaluation", scale)
+    uri, exp, tags = experiments.open_experiment(logger, "evaluation", scale)
     client = tracking.open_store(uri)
     trainings = [lineage.training_lineage(n, p) for n, p in sorted(files.trainings.items())]
     read = {"predict.json": files.predict, "ideas.json": files.ideas}
@@ -63,10 +63,10 @@ def log_evaluation(logger: tracking.LoggerConfig, scale: str, params: dict,
     used = {f"{n.removesuffix('.json')}_run": r.info.run_id for n, r in found.items() if r}
     own = training_tags(trainings) | run_text.claim_tags(summary["claims"]["rows"]) | used
     mlflow.set_tracking_uri(uri)
-    name = tracking.run_name(f"evaluation {scale}")
+    name = experiments.run_name(f"evaluation {scale}")
     with mlflow.start_run(experiment_id=exp, run_name=name, tags=tags | own) as parent:
         run_id = parent.info.run_id
-        mlflow.log_params(tracking.flat_params(params))
+        mlflow.log_params(experiments.flat_params(params))
         mlflow.log_metrics(run_text.headline_metrics(summary, headline))
         for text in summary["keys"]:
             log_configuration(exp, scale, tags, text, sources, summary)
@@ -145,7 +145,7 @@ def lineage_lines(exp: str, trainings: list[lineage.Training], found: dict) -> l
 def config_params(key: ConfigKey) -> dict[str, str]:
     """The MLflow params of one configuration (module doc); ``null`` where it has none (a
     ``mix`` of ``null``: the parent's ``planner.mix``)."""
-    p = tracking.param_text
+    p = experiments.param_text
     return {
         "planner": key.planner,
         "tau": p(key.tau),
@@ -171,5 +171,5 @@ def config_metrics(summary: dict, text: str) -> dict[str, float]:
                 "median_iterations": it["median"],
             }
             place = {map_set_slug(map_set): {stop_slug(stop, eps): vals}}
-            out.update(tracking.flat_metrics(place))
+            out.update(experiments.flat_metrics(place))
     return out

@@ -21,30 +21,30 @@ from pathlib import Path
 
 from vnrrt.evaluation.keys import ConfigKey
 from vnrrt.names import stop_slug
-from vnrrt.tracking import lineage
+from vnrrt.tracking import experiments, lineage
 from vnrrt.tracking import store as tracking
 
 SPEEDUP = ("speedup", "ci_low", "ci_high")
 
 
 def log_ideas(
-    logger: tracking.LoggerConfig, scale: str, params: dict, summary: dict, artifacts: list[Path]
+    logger: experiments.LoggerConfig, scale: str, params: dict, summary: dict, artifacts: list[Path]
 ) -> str:
     """The parent run and its nested runs (module doc; ``params``: the settings to log,
     nested; ``artifacts``: the report (``.md``), the summary (``.json``) and the figures);
     returns the parent's id."""
     import mlflow
 
-    uri, exp, tags = tracking.open_experiment(logger, "ideas", scale)
+    uri, exp, tags = experiments.open_experiment(logger, "ideas", scale)
     client = tracking.open_store(uri)
     mlflow.set_tracking_uri(uri)
     files = [Path(p) for p in artifacts if Path(p).is_file()]
     extra = {}
     for path in (p for p in files if p.suffix == ".json"):
         extra |= lineage.content_tag(path.name, path)
-    name = tracking.run_name(f"ideas {scale}")
+    name = experiments.run_name(f"ideas {scale}")
     with mlflow.start_run(experiment_id=exp, run_name=name, tags=tags | extra) as run:
-        mlflow.log_params(tracking.flat_params(params))
+        mlflow.log_params(experiments.flat_params(params))
         mlflow.log_metrics(headline_metrics(summary))
         cells = dict.fromkeys((r["regime"], r["configuration"]) for r in summary["cells"])
         for cell, text in cells:
@@ -110,7 +110,7 @@ def config_params(key: ConfigKey, cell: str) -> dict[str, str]:
     from vnrrt.evaluation.oracles import OracleSource
     from vnrrt.evaluation.sources import is_oracle
 
-    p = tracking.param_text
+    p = experiments.param_text
     oracle = OracleSource.parse(key.source) if is_oracle(key.source) else None
     return {
         "planner": key.planner,
@@ -140,7 +140,7 @@ def cell_metrics(summary: dict, cell: str, text: str) -> dict[str, float]:
         vals["speedup_over_rrt_star"] = {
             m: {s: c[m][s] for s in SPEEDUP} for m in ("iterations", "time_to_stop") if m in c
         }
-        out.update(tracking.flat_metrics({stop_slug(c["stop"], eps): vals}))
+        out.update(experiments.flat_metrics({stop_slug(c["stop"], eps): vals}))
     return out
 
 
@@ -156,7 +156,7 @@ def headline_metrics(summary: dict) -> dict[str, float]:
     for r in summary.get("networks", []):
         name = f"{r['configuration']}_vs_{r['idea']}_envelope"
         tree.setdefault(stop_slug(r["stop"], eps), {})[name] = _readings(r)
-    return tracking.flat_metrics(tree)
+    return experiments.flat_metrics(tree)
 
 
 def _readings(row: dict) -> dict:
