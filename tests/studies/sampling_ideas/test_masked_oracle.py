@@ -24,7 +24,7 @@ from vnrrt.planners import PlannerConfig
 from vnrrt.studies.sampling_ideas.design import MASKED_IDEA, family_members
 from vnrrt.studies.sampling_ideas.findings import conclusion
 from vnrrt.studies.sampling_ideas.report import envelope_table
-from vnrrt.studies.sampling_ideas.summary import network_rows
+from vnrrt.studies.sampling_ideas.rows import network_rows
 
 CORNERS = [(8, 40), (40, 40)]  # the hand-made path's interior vertices (x, y), 32 px apart
 

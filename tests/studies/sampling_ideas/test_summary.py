@@ -1,11 +1,11 @@
 """The sampling-ideas summary's per-cell rows
-(:func:`vnrrt.studies.sampling_ideas.summary.cell_rows`) on a hand-made table: success, the
+(:func:`vnrrt.studies.sampling_ideas.rows.cell_rows`) on a hand-made table: success, the
 runs the time budget and the runs' cap cut, and the speed-up."""
 
 import pandas as pd
 import pytest
 
-from vnrrt.studies.sampling_ideas.summary import cell_rows
+from vnrrt.studies.sampling_ideas.rows import cell_rows
 
 
 def _rows(key: str, iterations: list[int], reasons: list[str], runs=None) -> list[dict]:
