@@ -253,6 +253,7 @@ def ideas_summary(tables: dict, settings: dict, free: dict[int, int] | None = No
              "tail_draws": stats.tail_draws}  # fmt: skip
     shown |= {"radius": st.oracle.radius, "floor": st.oracle.floor}
     shown |= {"zero_obstacles": st.ev.zero_obstacles, "selection_share": st.oracle.selection_share}
+    shown |= {"cap_factor": st.ev.cap_factor}
     predict = read_json(st.paths.predict_metrics)["networks"]
     study = {"oracle": st.oracle, "regime": st.regime, "ev": st.ev, "protocol": st.protocol,
              "targets": {n: m["target"] for n, m in predict.items()}, "tau": rules.tau}  # fmt: skip

@@ -15,9 +15,9 @@
   <scale>``, followed by an ablation's overrides (``evaluation quick tau=0.7``:
   :func:`~vnrrt.tracking.experiments.run_name`), tagged with kind, scale, git commit, DVC
   stage and experiment, and the overrides in full (``overrides``: ``planner.tau=0.7``, or
-  ``none``); params spelled as in YAML (:func:`~vnrrt.tracking.experiments.param_text`). What each run holds: ``vnrrt.training.runs``,
-  ``vnrrt.predict.runs``, ``vnrrt.evaluation.*.runs``; lineage between them:
-  :mod:`vnrrt.tracking.lineage`.
+  ``none``); params spelled as in YAML (:func:`~vnrrt.tracking.experiments.param_text`).
+  What each run holds: ``vnrrt.training.runs``, ``vnrrt.predict.runs``,
+  ``vnrrt.studies.*.runs``; lineage between them: :mod:`vnrrt.tracking.lineage`.
 * **Telemetry** is off (``MLFLOW_DISABLE_TELEMETRY=true`` unless set otherwise before vnrrt
   is imported): stages make no network calls. ``MLFLOW_DISABLE_TELEMETRY=false`` turns it on.
 * **Services**: a tracking server (``http(s)://``) or database (``postgresql://`` ...) is

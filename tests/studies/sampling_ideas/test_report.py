@@ -57,7 +57,8 @@ def test_only_cells_with_runs_stopped_by_the_budget_are_listed():
                    ("eta=inf", 1.0, 0.5, "vnrrt_star", 0, 0)]  # fmt: skip
     table = budget_table(summary, "optimal")
     assert "| eta=10 | 90.0% | 75.0% | NRRT* | 3 | 1 |" in table and "protocol" not in table
-    assert "3 runs over every" in table and "(the last column, 1 in all)" in table
+    assert "(3 runs over every" in table and "(the last column, 1 in all)" in table
+    assert "cap is 1 times it" in table  # a summary without the setting: its runs stopped there
     assert "| eta=inf | 100.0% | 50.0% | VNRRT* | 0 | 0 |" in table
     for row in summary["cells"]:  # a summary written before the cap: its time budget was it
         del row["cut_by_cap"]

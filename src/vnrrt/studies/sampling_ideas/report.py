@@ -52,15 +52,16 @@ def budget_table(summary: dict, stop: str) -> str:
     if not rows:
         return "Every run of every cell reached the stop rule within the budget."
     cut, cap = sum(r[4] for r in rows), sum(r[5] for r in rows)
+    factor = float(summary.get("settings", {}).get("cap_factor", 1.0))
     lines = [
         "Runs that reached the stop rule within the budget, where some did not (the others "
         "enter the statistics at the budget, censored: RRT*'s censored runs make a speed-up a "
         "lower bound, the planner's an upper bound). The time budget (`planner.max_seconds`) "
-        "is applied after each run, whose own wall-clock cap is `eval.cap_factor` times it: "
-        "a run over the budget counts as stopped there in the time readings (the column "
-        f'"by the time budget", {cut} runs over every configuration of these cells), while '
-        "the iteration readings see it stopped by the iteration budget only, unless it reached "
-        "the cap: such a run stops at an iteration count that depends on the machine's speed "
+        f"is applied after each run, whose own wall-clock cap is {factor:g} times it "
+        "(`eval.cap_factor`): a run over the budget counts as stopped there in the time "
+        f"readings ({cut} runs over every configuration of these cells), while the iteration "
+        "readings see it stopped by the iteration budget only, unless it reached the cap: such "
+        "a run stops at an iteration count that depends on the machine's speed "
         f"(the last column, {cap} in all"
         + (")." if cap else "; no iteration reading here depends on the machine's speed)."),
         "",
