@@ -115,7 +115,8 @@ def run_job(
     job, inst = args
     key, stop, config = job.key, job.stop, reuse.job_config(job, configs)
     budget = config.max_seconds  # the time readings' budget; the run's cap heat.cap_factor x
-    config = config.replace(max_seconds=budget * heat.cap_factor)
+    if heat.cap_factor != 1.0:
+        config = config.replace(max_seconds=budget * heat.cap_factor)
     warmup()
     free = free_rule(key, heat.zero_obstacles)
     allowed = sources.allowed_cells(inst.grid, free)
