@@ -189,8 +189,8 @@ def _paired(base: pd.DataFrame, plan: pd.DataFrame, metric: str) -> dict[str, np
     the same unique pairs (what an inner merge with a row-count check tests, at a fraction of
     its cost: a comparison is made hundreds of times per report)."""
     keys = ["instance", "trial"]
-    cols = [*keys, "cluster", metric, "success"]
-    b, p = ({c: v.to_numpy() for c, v in _with_success(t, metric)[cols]
+    cols = [*keys, "cluster", metric, "success"]  # success as the metric's reading counts it
+    b, p = ({c: v.to_numpy() for c, v in t[cols[:-1]].assign(success=solved(t, metric))
              .sort_values(keys, kind="stable").items()} for t in (base, plan))  # fmt: skip
     same = len(b["trial"]) == len(p["trial"]) and all(np.array_equal(b[k], p[k]) for k in keys)
     if not same or pd.MultiIndex.from_arrays([b[k] for k in keys]).has_duplicates:
@@ -200,11 +200,6 @@ def _paired(base: pd.DataFrame, plan: pd.DataFrame, metric: str) -> dict[str, np
         )
     rest = {f"{c}{s}": t[c] for c in cols[2:] for s, t in (("_b", b), ("_p", p))}
     return {"instance": b["instance"], "trial": b["trial"], **rest}
-
-
-def _with_success(t: pd.DataFrame, metric: str) -> pd.DataFrame:
-    """``t`` with ``success`` as ``metric``'s reading counts it (:func:`.table.solved`)."""
-    return t.assign(success=solved(t, metric)) if metric == "iterations" else t
 
 
 def compare(

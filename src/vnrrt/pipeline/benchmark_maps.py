@@ -20,14 +20,13 @@ from omegaconf import DictConfig
 
 from vnrrt.config import ConfigError, sections
 from vnrrt.config.paths import Paths
-from vnrrt.evaluation.config import check_cap_factor
 
 log = logging.getLogger(__name__)
 
 
 def bench_settings(cfg: DictConfig) -> dict:
     """What stage ``bench_maps@<name>`` reads, typed (keyed by config section)."""
-    from vnrrt.evaluation.config import StatsConfig
+    from vnrrt.evaluation.config import StatsConfig, check_cap_factor
     from vnrrt.planners.config import PlannerConfig
     from vnrrt.studies.benchmark_maps.config import BenchMapsConfig
     from vnrrt.tracking.experiments import LoggerConfig

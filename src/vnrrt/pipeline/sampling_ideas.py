@@ -21,13 +21,7 @@ from omegaconf import DictConfig
 
 from vnrrt.config import ConfigError, check_parts, conf_defaults, section, sections
 from vnrrt.config.paths import Paths
-from vnrrt.evaluation.config import (
-    Configurations,
-    OracleConfig,
-    RegimeConfig,
-    RegimeGrid,
-    Rules,
-)
+from vnrrt.evaluation.config import Configurations, OracleConfig, RegimeConfig, RegimeGrid, Rules
 
 log = logging.getLogger(__name__)
 

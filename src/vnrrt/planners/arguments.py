@@ -86,7 +86,7 @@ def check_seed(seed) -> None:
     """Raise ``ValueError`` unless ``seed`` is an int >= 0 or a tuple (or list) of them
     (``numbers.Integral``: numpy ints and bools too)."""
     for part in seed if isinstance(seed, tuple | list) else (seed,):
-        if (type(part) is not int and not isinstance(part, numbers.Integral)) or part < 0:
+        if not isinstance(part, numbers.Integral) or part < 0:
             raise ValueError(f"seed must be an int >= 0 or a tuple of them, got {seed!r}")
 
 
@@ -99,9 +99,7 @@ def check_stop_target(stop, reference_length, start, goal, config=None) -> None:
     ``goal`` are checked points ``(x, y)`` (:func:`endpoint`)."""
     if reference_length is None:
         return
-    if type(reference_length) is not float and (
-        isinstance(reference_length, bool) or not isinstance(reference_length, numbers.Real)
-    ):
+    if isinstance(reference_length, bool) or not isinstance(reference_length, numbers.Real):
         raise TypeError(f"reference_length must be a number (pixels) or None, got "
                         f"{type(reference_length).__name__} {reference_length!r}")  # fmt: skip
     ref = float(reference_length)

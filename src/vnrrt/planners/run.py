@@ -241,7 +241,7 @@ def result(planner: str, query: Query, budget: tuple[int, float], *, reason: str
         trace_costs=trace_costs,
         reference_length=query.reference_length,
         target_cost=query.target,
-        milestones=tuple([Milestone(b, *reached[b]) for b in query.bounds]),
+        milestones=tuple(Milestone(b, *reached[b]) for b in query.bounds),
         fallback_uniform=query.fallback_uniform,
         setup_time=query.setup_time,
         budget=budget,

@@ -18,7 +18,6 @@ seeded by :class:`numpy.random.SeedSequence` (:func:`rng_state`).
 
 from __future__ import annotations
 
-import functools
 import math
 from dataclasses import dataclass
 from typing import NamedTuple
@@ -115,13 +114,8 @@ class Sampler:
 
 
 def uniform_sampler(shape: tuple[int, int]) -> Sampler:
-    """Uniform sampler over the ``(H, W)`` map (one per shape: it holds no weights)."""
-    return _uniform(int(shape[0]), int(shape[1]))
-
-
-@functools.lru_cache(maxsize=64)
-def _uniform(h: int, w: int) -> Sampler:
-    return Sampler("uniform", 0.0, np.zeros(0), -1, (h, w))
+    """Uniform sampler over the ``(H, W)`` map."""
+    return Sampler("uniform", 0.0, np.zeros(0), -1, (int(shape[0]), int(shape[1])))
 
 
 def heatmap_sampler(
