@@ -33,6 +33,7 @@ from vnrrt.pipeline.training_budget import (
 )
 from vnrrt.pipeline.validate import validate_config
 from vnrrt.studies.training_budget.budget import batches_per_epoch
+from vnrrt.studies.training_budget.summary import TEST
 
 N_RANDOM = 6
 # The settings a reader sees, none at its default: the report and figures must name these.
@@ -194,6 +195,17 @@ def test_each_training_seed_trains_other_weights(curve):
     for name in NETWORKS:
         sums = {(models / f"budget/4-{s}/{name}.ckpt.sha256").read_text() for s in SEEDS}
         assert len(sums) == 2, name
+
+
+def test_the_summary_carries_each_trainings_test_split_metrics(curve):
+    """Each seed's training at each budget: its test-split metrics in the summary (the
+    networks table of docs/results.md reads them), as its training wrote them."""
+    cfg, summary = curve
+    for b, name, seed in ((b, n, s) for b in summary["budgets"] for n in NETWORKS for s in SEEDS):
+        path = Path(cfg.paths.budget) / f"{b['steps']}-{seed}/train_{name}.json"
+        wrote = json.loads(path.read_text())
+        kept = b["networks"][name]["train"][str(seed)]
+        assert {k: kept[k] for k in TEST} == {k: wrote[k] for k in TEST}
 
 
 def test_a_budget_stage_measures_its_heatmaps_as_predict_metrics_does(curve):

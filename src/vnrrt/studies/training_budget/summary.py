@@ -28,6 +28,10 @@ HEAT = ("interior_ap", "path_ap", "mass_near_interior", "mass_near_path", "mass_
 RAW = ("interior_recall", "vertex_recall")  # shown as they are (a constant map's is 0 or 1)
 TRAIN = ("train_images", "epochs", "fit_seconds", "val/loss", "val/interior_ap", "val/path_ap",
          "checkpoint_sha256", "mlflow_run_id", "budget")  # fmt: skip
+# the test split's metrics of each training (held-out base maps; docs/results.md's networks)
+TEST = ("test/interior_ap", "test/interior_recall", "test/path_ap", "test/mass_near_interior",
+        "test/mass_near_interior_uniform", "test/mass_near_path", "test/mass_near_path_uniform",
+        "test/mass_on_endpoints")  # fmt: skip
 BASELINE, CONTROL = "rrt_star", "nrrt_star"
 
 
@@ -92,7 +96,7 @@ def budget_point(inp: dict, settings: dict) -> dict:
                 k: _compare(rows[CONTROL], rows[k], metric, settings)
                 for k in settings["ratio_keys"]}  # fmt: skip
     heat = heat_ratios(inp["predict"])
-    networks = {n: {"train": {k: t[k] for k in TRAIN if k in t}, "heatmap": heat[n]}
+    networks = {n: {"train": {k: t[k] for k in (*TRAIN, *TEST) if k in t}, "heatmap": heat[n]}
                 for n, t in inp["trainings"].items()}  # fmt: skip
     images = {int(t["train_images"]) for t in inp["trainings"].values()}
     if len(images) != 1:
