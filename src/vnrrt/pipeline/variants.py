@@ -13,7 +13,7 @@ the path ends the target keeps (``networks.vertexnet.endpoints``), the target di
 positive weight (``model.loss.alpha``) and the output prior (``model.net.prior``); a variant
 equal to the baseline is run once. Then the combination of every factor's best level, where
 two or more factors beat the baseline. Each variant is a budget training
-(:func:`vnrrt.pipeline.training_budget.run_budget_train`: a one-cycle schedule of its own
+(:func:`vnrrt.pipeline.budget_training.run_budget_train`: a one-cycle schedule of its own
 ``--steps``)
 in ``--work/<variant>/`` (default ``models/<scale>/variants``), MLflow off; a finished one
 is read back, an interrupted one resumes. Needs the scale's shards (``dvc repro manifest``
