@@ -6,9 +6,11 @@ optimal lengths, from their cells' centres), ``--seeds`` seeds each. Ours: the d
 ``plan()`` (:data:`vnrrt.planners.USER`, our fastest settings; its time budget capped at
 ``--limit``), RRT* stopping at 1.01 x the exact any-angle optimum
 (:func:`vnrrt.search.any_angle_length`). Native OMPL 1.5 (``ompl_native``: C++ grid checker,
-motions checked every 0.5 px, OMPL's default settings, stopping at the same cost or at
-``--limit`` s): RRT-Connect for first solutions, BIT*, ABIT* and Informed RRT* to the bound
-(their first solutions counted too). Per run, seconds from the start of the planner's own
+motions checked every 0.5 px, stopping at the same cost or at ``--limit`` s), at OMPL's
+default settings and, matched (``-m``), with our Steer step (the default's ``eta``) as the
+range of the planners that have one: RRT-Connect (and RRT-Connect-m) for first solutions,
+BIT*, ABIT*, Informed RRT* and Informed RRT*-m to the bound (their first solutions counted
+too). Per run, seconds from the start of the planner's own
 solve to its first solution and to the bound, as each measures them (ours:
 ``time_to_first``/``time_to_stop``; OMPL: timed in C++ from the start of ``solve()``).
 Runs alternate per query and seed, ours first. A final path that crosses an obstacle cell
@@ -43,10 +45,11 @@ from vnrrt.planners import USER, path_free, plan, warmup
 from vnrrt.search import any_angle_length
 
 ROOT = Path(__file__).resolve().parents[1]
-FIRST = (ompl_native.RRT_CONNECT, "BITstar", "ABITstar")  # OMPL's for first solutions
-OPTIMAL = ("BITstar", "ABITstar", "InformedRRTstar")  # OMPL's to the bound
-SHORT = {"RRTConnect": "RRTC", "BITstar": "BIT*", "ABITstar": "ABIT*",
-         "InformedRRTstar": "IRRT*"}  # fmt: skip
+MATCHED = "-m"  # a planner name's suffix: OMPL's range set to our Steer step (USER.eta)
+FIRST = (ompl_native.RRT_CONNECT, ompl_native.RRT_CONNECT + MATCHED, "BITstar", "ABITstar")
+OPTIMAL = ("BITstar", "ABITstar", "InformedRRTstar", "InformedRRTstar" + MATCHED)  # to the bound
+SHORT = {"RRTConnect": "RRTC", "RRTConnect-m": "RRTC-m", "BITstar": "BIT*", "ABITstar": "ABIT*",
+         "InformedRRTstar": "IRRT*", "InformedRRTstar-m": "IRRT*-m"}  # fmt: skip
 
 
 def run_ours(grid, s, e, exact: float, seed: int, limit: float) -> dict:
@@ -60,7 +63,9 @@ def run_ours(grid, s, e, exact: float, seed: int, limit: float) -> dict:
 
 
 def run_native(native, grid, s, e, bound: float, limit: float, name: str) -> dict:
-    r = native.solve(name, s, e, bound, limit)
+    """OMPL's ``name`` (with :data:`MATCHED`: its range our Steer step) to ``bound`` px."""
+    step = USER.eta if name.endswith(MATCHED) else 0.0
+    r = native.solve(name.removesuffix(MATCHED), s, e, bound, limit, step)
     clipped = len(r.path) > 0 and not path_free(grid, r.path)
     return {"first": r.first, "stop": r.stop, "clipped": clipped}
 
@@ -101,9 +106,9 @@ def paired(ours: list[dict], theirs: list[dict], key: str) -> str:
 
 def section(per_map: dict, key: str, names: tuple, limit: float) -> list[str]:
     """The table to ``key`` ('first' or 'stop') over ``names`` (OMPL's) beside ours."""
-    head = (f"{'map':<11}{'ours':>7}" + "".join(f"{SHORT[n]:>7}" for n in names)
-            + f"{'ours ms':>10}" + "".join(f"{SHORT[n] + ' ms':>10}" for n in names)
-            + f"{'best':>7}{'ratio':>9}{'paired':>12}  clipped")  # fmt: skip
+    head = (f"{'map':<11}{'ours':>8}" + "".join(f"{SHORT[n]:>8}" for n in names)
+            + f"{'ours ms':>11}" + "".join(f"{SHORT[n] + ' ms':>11}" for n in names)
+            + f"{'best':>8}{'ratio':>9}{'paired':>12}  clipped")  # fmt: skip
     lines = [head]
     for name, runs in per_map.items():
         n = len(runs["ours"])
@@ -113,9 +118,9 @@ def section(per_map: dict, key: str, names: tuple, limit: float) -> list[str]:
         best = min(names, key=lambda p: (meds[p][0], -wins[p], p))  # ties: the most solved
         (o, ol), (b, bl) = meds["ours"], meds[best]
         ratio = f"{'>' if bl else ''}{b / o:.3g}x" if o > 0 and not ol else "-"
-        line = f"{name:<11}" + "".join(f"{f'{k}/{n}':>7}" for k in solved)
-        line += "".join(cell(*meds[p], 10) for p in ("ours", *names))
-        line += f"{SHORT[best]:>7}{ratio:>9}{paired(runs['ours'], runs[best], key):>12}  "
+        line = f"{name:<11}" + "".join(f"{f'{k}/{n}':>8}" for k in solved)
+        line += "".join(cell(*meds[p], 11) for p in ("ours", *names))
+        line += f"{SHORT[best]:>8}{ratio:>9}{paired(runs['ours'], runs[best], key):>12}  "
         line += "/".join(str(sum(r["clipped"] for r in runs[p])) for p in ("ours", *names))
         lines.append(line)
     return lines
@@ -154,15 +159,16 @@ def main(argv: list[str] | None = None) -> int:
     after = os.getloadavg()
     lines = [f"# {code}",
              f"# {args.longest} longest queries x {args.seeds} seeds per map; ours: plan()'s "
-             f"default (conf/planner/user.yaml) vs native OMPL 1.5 at OMPL's defaults; "
+             f"default (conf/planner/user.yaml) vs native OMPL 1.5 at OMPL's defaults and (-m) "
+             f"with our Steer step, {USER.eta:g} px, as its range; "
              f"{args.limit:g} s per query each; times in ms (> : a lower bound, the median "
              "run unsolved); ratio: best OMPL median / ours; paired: median of OMPL's best / "
              "ours over the runs it solved (count)",
              f"# 1-min load average {load[0]:.2f} before, {after[0]:.2f} after; clipped "
              f"paths (crossing an obstacle cell; still counted): {clipped}",
-             "", "first solution (OMPL: RRT-Connect, BIT*, ABIT*)",
+             "", "first solution (OMPL: RRT-Connect, RRT-Connect-m, BIT*, ABIT*)",
              *section(per_map, "first", FIRST, args.limit),
-             "", "to 1.01 x the exact optimum (OMPL: BIT*, ABIT*, Informed RRT*)",
+             "", "to 1.01 x the exact optimum (OMPL: BIT*, ABIT*, Informed RRT*, Informed RRT*-m)",
              *section(per_map, "stop", OPTIMAL, args.limit),
              "", "to 1.01 x the exact optimum, a run whose path crosses an obstacle cell "
              "counted as unsolved",
