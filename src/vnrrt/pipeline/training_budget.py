@@ -76,6 +76,8 @@ def _design(cfg: DictConfig) -> dict:
     return {
         "planners": [str(p) for p in ev.planners],
         "sources": {str(k): str(v) for k, v in ev.sources.items()},
+        "named_initial": int(ev.named_initial),
+        "named_optimal": int(ev.named_optimal),
         "random_initial": int(ev.random_initial),
         "random_optimal": int(ev.random_optimal),
         "any_angle": bool(ev.any_angle),

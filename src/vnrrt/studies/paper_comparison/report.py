@@ -119,8 +119,8 @@ def build_report(inp: ReportInputs) -> str:
         multiple_note(summary["claims"]),
         "",
         "These claims read one trained network pair (the pipeline's `train.seed`): their "
-        "intervals hold no training variance. The random-map claims read over several "
-        "training seeds' network pairs, with intervals that include it, are in "
+        "intervals hold no training variance. The claims read over several training seeds' "
+        "network pairs, with intervals that include it, are in "
         "[training_budget.md](training_budget.md) at the scales that train them "
         "(`budget.seeds`).",
         "",

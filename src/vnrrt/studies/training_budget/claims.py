@@ -1,13 +1,15 @@
-"""The paper's random-map claims read over several trained networks: at one training budget
-(the largest of the curve, the pipeline's own training), every seed's network pair through
-the same random instances and trial seeds, pooled.
+"""The paper's claims read over several trained networks: at one training budget (the
+largest of the curve, the pipeline's own training), every seed's network pair through the
+same instances and trial seeds, pooled.
 
-Each claim whose configurations the budget trials run (random-map column; RRT*, NRRT*,
-VNRRT*, M-VNRRT* at ``planner.tau``) is read as the paper comparison reads it
+Each claim whose configurations and map set the budget trials run (RRT*, NRRT*, VNRRT*,
+M-VNRRT* at ``planner.tau``; the random maps and the named maps) is read as the paper
+comparison reads it
 (:mod:`vnrrt.studies.paper_comparison.claims`): planning time and iterations, our estimand
 (geometric mean over instances of median(baseline) / median(planner)), at the family-wise
 level over the claims read here (Bonferroni), the verdict judged against the paper's value
-and, by the interval of the difference, against the paper's own interval. The pooled
+and, by the interval of the difference, against the paper's own interval; a claim off the
+paper's comparable map set (a named map: ours are not the paper's) is marked so. The pooled
 interval resamples training seeds, then base maps, instances and trials
 (:func:`vnrrt.evaluation.seeds.seed_compare`): it includes the training variance. Beside it,
 every seed's own reading (its network pair alone: base maps, instances and trials
@@ -28,13 +30,13 @@ from vnrrt.studies.paper_comparison.paper_noise import claim_interval
 from vnrrt.studies.paper_comparison.readings import difference, reading_verdict
 from vnrrt.studies.training_budget.pooled import paired_rows
 
-COLUMN = "random"  # the map set the budget trials run
 METRICS = ("time_to_stop", "iterations")
 
 
-def readable(paper: dict, keys: list[str]) -> list[dict]:
-    """The quoted claims on the random maps whose baseline and planner are in ``keys``."""
-    ok = [c["column"] == COLUMN and {c["baseline"], c["planner"]} <= set(keys)
+def readable(paper: dict, keys: list[str], map_sets: set[str]) -> list[dict]:
+    """The quoted claims whose baseline and planner are in ``keys`` and whose column (map
+    set) is one of ``map_sets``."""
+    ok = [c["column"] in map_sets and {c["baseline"], c["planner"]} <= set(keys)
           for c in paper["claims"]]  # fmt: skip
     return [c for c, keep in zip(paper["claims"], ok, strict=True) if keep]
 
@@ -53,13 +55,13 @@ def _per_seed(runs: list[dict], claim: dict, stop: str, iv: dict, n_boot: int, l
     out = {}
     for run in runs:
         t = run["trials"]
-        sel = t[(t["map_set"] == COLUMN) & (t["stop"] == stop)]
+        sel = t[(t["map_set"] == claim["column"]) & (t["stop"] == stop)]
         base, plan = sel[sel["key"] == claim["baseline"]], sel[sel["key"] == claim["planner"]]
         cell = {}
         for metric in METRICS:
             c = compare(base, plan, metric, n_boot=n_boot, level=level)
             cell[metric] = _verdict(c.speedup, c.ci_low, c.ci_high, claim, iv, level)
-        shares = mask_shares(sel).get(stop, {}).get(claim["planner"], {}).get(COLUMN)
+        shares = mask_shares(sel).get(stop, {}).get(claim["planner"], {}).get(claim["column"])
         masked = "@" in claim["planner"]
         cell["testability"] = testability(
             shares if masked else None, st.untestable_endpoint_share, st.untestable_fallback
@@ -73,8 +75,11 @@ def seed_claims(runs: list[dict], paper: dict, st, keys: list[str], tables: dict
     module doc). ``st``: the ``stats`` section; ``keys``: the budget trials' configurations;
     ``tables``: ``paper["tables"]`` (each claim's stop rule). Returns ``level``,
     ``corrected_level``, ``bootstrap``, ``seeds`` and one row per claim: the claim's
-    fields, ``paper`` (its interval), ``pooled`` ``{metric: reading}`` and ``per_seed``."""
-    claims = readable(paper, keys)
+    fields, ``comparable`` (its map set is the paper's comparable one), ``paper`` (its
+    interval), ``pooled`` ``{metric: reading}`` and ``per_seed``."""
+    map_sets = set().union(*(set(r["trials"]["map_set"]) for r in runs))
+    claims = readable(paper, keys, map_sets)
+    comparable = set(paper.get("comparable_columns", []))
     strict = bonferroni_level(st.level, max(len(claims), 1))
     n_boot = claim_boot(st.bootstrap, st.tail_draws, strict)
     rows = []
@@ -83,14 +88,16 @@ def seed_claims(runs: list[dict], paper: dict, st, keys: list[str], tables: dict
         iv = claim_interval(paper, claim, strict).as_dict()
         pooled = {}
         for metric in METRICS:
-            pairs = paired_rows(runs, claim["baseline"], claim["planner"], stop, metric)
+            pairs = paired_rows(runs, claim["baseline"], claim["planner"], stop, metric,
+                                map_set=claim["column"])  # fmt: skip
             c = seed_compare(pairs, metric, n_boot=n_boot, level=strict)
             pooled[metric] = _verdict(c["speedup"], c["ci_low"], c["ci_high"], claim, iv, strict)
             pooled[metric]["per_seed_point"] = c["per_seed"]
         per_seed = _per_seed(runs, claim, stop, iv, n_boot, strict, st)
         testable = sum(s["testability"]["testable"] for s in per_seed.values())
-        rows.append({**claim, "stop": stop, "paper": iv, "pooled": pooled,
-                     "per_seed": per_seed, "testable_seeds": testable})  # fmt: skip
+        rows.append({**claim, "stop": stop, "comparable": claim["column"] in comparable,
+                     "paper": iv, "pooled": pooled, "per_seed": per_seed,
+                     "testable_seeds": testable})  # fmt: skip
     return {"level": st.level, "corrected_level": strict, "bootstrap": n_boot,
             "seeds": [int(r["seed"]) for r in runs], "rows": rows,
             "untestable_rule": testability_rule(st)}  # fmt: skip

@@ -1,4 +1,4 @@
-"""The report's section on the paper's random-map claims over the training seeds' networks
+"""The report's section on the paper's claims over the training seeds' networks
 (:mod:`.claims`), from the summary alone."""
 
 from __future__ import annotations
@@ -24,22 +24,26 @@ def seed_claims_section(summary: dict) -> list[str]:
     head = ["claim", "paper", "pooled over seeds: time [CI]", "verdict (pooled)",
             "pooled: iterations [CI]", "each seed: time [CI], verdict",
             "seeds whose sampler tests the claim"]  # fmt: skip
-    lines = ["## The random-map claims over training seeds", "",
-             f"The paper's quoted claims on random maps, read at the largest budget ({steps:,} "
+    lines = ["## The paper's claims over training seeds", "",
+             f"The paper's quoted claims, read at the largest budget ({steps:,} "
              f"steps) over the networks of training seeds {seeds}: "
              "pooled, the interval resamples the seeds, then base maps, instances and trials, so "
              "it includes the training variance; beside it, each seed's network pair alone. "
              "Planning time, our estimand (geometric mean over instances of median(baseline) / "
              f"median(planner)), at {level_name(c['corrected_level'])} (Bonferroni over the "
              f"{len(c['rows'])} claims read here; {c['bootstrap']:,} resamples); verdicts as in "
-             "the paper comparison, against the paper's value and its own interval. A masked "
-             f"claim is untestable with a network when {c['untestable_rule']}.",
+             "the paper comparison, against the paper's value and its own interval; a claim on "
+             "a named map is 'different map: not comparable' (ours are not the paper's maps). "
+             f"A masked claim is untestable with a network when {c['untestable_rule']}.",
              "", "| " + " | ".join(head) + " |", "|" + " --- |" * len(head)]  # fmt: skip
     for row in c["rows"]:
         pooled = row["pooled"]
         per = "; ".join(_seed_cell(k, v) for k, v in row["per_seed"].items())
+        verdict = pooled["time_to_stop"]["verdict"]
+        if not row.get("comparable", True):
+            verdict = f"different map: not comparable ({verdict})"
         cells = [row["text"], f"{row['quoted']:+.2%}", improvement(pooled["time_to_stop"]),
-                 pooled["time_to_stop"]["verdict"], improvement(pooled["iterations"]), per,
+                 verdict, improvement(pooled["iterations"]), per,
                  f"{row['testable_seeds']} of {len(row['per_seed'])}"]  # fmt: skip
         lines.append("| " + " | ".join(cells) + " |")
     return [*lines, ""]

@@ -1,10 +1,13 @@
-"""What the budget curve's trials run, per budget (stage ``budget_trials@<steps>``): RRT* and
-every learned planner of ``eval.planners`` sampling its ``eval.sources`` network, M-VNRRT* at
-the claims' threshold ``planner.tau`` only, not informed, on the random instances of the
-instances file (the comparable map set), every stop rule of the protocol with its trial
-counts (``eval.random_initial``, ``eval.random_optimal``, ``eval.any_angle``), its obstacle
-rule (``eval.zero_obstacles``) and its paired seeds, so that a budget's configurations are
-compared on the same trials, and the budgets on the same instances and seeds.
+"""What the budget curve's trials run, per budget (stage ``budget_trials@<steps>-<seed>``):
+RRT* and every learned planner of ``eval.planners`` sampling its ``eval.sources`` network,
+M-VNRRT* at the claims' threshold ``planner.tau`` only, not informed, on every instance of
+the instances file: the random instances (the comparable map set, which the curve reads) and
+the named maps (the paper's named-map claims, read over the training seeds at the largest
+budget), every stop rule of the protocol with its trial counts (``eval.named_initial``,
+``eval.named_optimal``, ``eval.random_initial``, ``eval.random_optimal``,
+``eval.any_angle``), its obstacle rule (``eval.zero_obstacles``) and its paired seeds, so
+that a budget's configurations are compared on the same trials, and the budgets and
+training seeds on the same instances and seeds.
 """
 
 from __future__ import annotations
@@ -25,6 +28,8 @@ class BudgetTrials:
 
     planners: list[str]
     sources: dict[str, str]
+    named_initial: int
+    named_optimal: int
     random_initial: int
     random_optimal: int
     any_angle: bool
@@ -43,9 +48,10 @@ class BudgetTrials:
         return configurations(ev, [tau], tau)
 
     def counts(self) -> dict[tuple[str, str], int]:
-        """Trials per random instance and stop rule (none on the named maps)."""
-        ev = EvalConfig(named_initial=0, named_optimal=0, random_initial=self.random_initial,
-                        random_optimal=self.random_optimal, any_angle=self.any_angle)  # fmt: skip
+        """Trials per instance for each (instance kind, stop rule), as the protocol's."""
+        ev = EvalConfig(named_initial=self.named_initial, named_optimal=self.named_optimal,
+                        random_initial=self.random_initial, random_optimal=self.random_optimal,
+                        any_angle=self.any_angle)  # fmt: skip
         return trial_counts(ev)
 
     def jobs(self, kinds: list[str], tau: float) -> list[TrialJob]:

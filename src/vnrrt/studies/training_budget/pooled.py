@@ -32,15 +32,16 @@ from vnrrt.studies.training_budget.summary import (
 BY = ["instance", "trial"]
 
 
-def paired_rows(inputs: list[dict], base: str, plan: str, stop: str, metric: str) -> pd.DataFrame:
-    """One row per (training seed, random instance, trial) of ``base`` and ``plan`` at one
-    stop rule: columns ``network_seed``, ``cluster``, ``instance``, ``trial``, ``base`` and
-    ``plan`` (the metric), ``base_ok`` and ``plan_ok`` (success); ``inputs``: one budget's
-    runs (``seed``, ``trials``)."""
+def paired_rows(inputs: list[dict], base: str, plan: str, stop: str, metric: str, *,
+                map_set: str = "random") -> pd.DataFrame:  # fmt: skip
+    """One row per (training seed, instance of ``map_set``, trial) of ``base`` and ``plan``
+    at one stop rule: columns ``network_seed``, ``cluster``, ``instance``, ``trial``,
+    ``base`` and ``plan`` (the metric), ``base_ok`` and ``plan_ok`` (success); ``inputs``:
+    one budget's runs (``seed``, ``trials``)."""
     frames = []
     for inp in inputs:
         t = inp["trials"]
-        t = t[(t["map_set"] == "random") & (t["stop"] == stop)]
+        t = t[(t["map_set"] == map_set) & (t["stop"] == stop)]
         t = t.assign(success=solved(t, metric))  # as the metric's reading counts a success
         cols = [*BY, "cluster", metric, "success"]
         b = t[t["key"] == base][cols].rename(columns={metric: "base", "success": "base_ok"})
