@@ -8,8 +8,9 @@ Each budget runs at every training seed of ``budget.seeds`` (the training varian
 * ``budget_predict@<steps>-<seed>``: the heatmaps and heatmap metrics of one budget's
   networks, a uniform map's metrics beside them -> ``paths.budget_heatmaps(steps, seed)``,
   ``paths.budget_predict_metrics(steps, seed)``;
-* ``budget_trials@<steps>-<seed>``: the trials of one budget on its networks' heatmaps ->
-  ``paths.budget_trials(steps, seed)`` (column ``network_seed``: ``seed``);
+* ``budget_trials@<steps>-<seed>``: the trials of one budget on its networks' heatmaps (the
+  named maps' too at the largest budget of ``budget.steps``) -> ``paths.budget_trials(steps,
+  seed)`` (column ``network_seed``: ``seed``);
 * ``budget_report@training_budget``: every budget's trials, heatmap metrics and training
   metrics (checked complete) -> the statistics (``paths.budget_summary``), the report
   (``paths.budget_report``) and its figures (``paths.budget_figures``).
@@ -93,6 +94,7 @@ def trials_settings(cfg: DictConfig) -> dict:
 
     return sections(cfg, paths=Paths, planner=PlannerConfig) | {
         "eval": _design(cfg),
+        "budget": {"steps": [int(n) for n in cfg.budget.steps]},
         "oracle": {"radius": float(cfg.oracle.radius)},
         "seed": int(cfg.seed),
         "workers": int(cfg.workers),
@@ -108,7 +110,8 @@ def run_budget_trials(cfg: DictConfig, steps: int, seed: int) -> int:
 
     s = trials_settings(cfg)
     paths, planner, design = s["paths"], s["planner"], BudgetTrials(**s["eval"])
-    jobs = design.jobs(Instances(paths.instances).kinds, planner.tau)
+    named = int(steps) == max(s["budget"]["steps"])  # the largest budget runs the named maps
+    jobs = design.jobs(Instances(paths.instances).kinds, planner.tau, named=named)
     networks = sorted({j.key.source for j in jobs if j.key.source is not None})
     indices = sorted({j.instance for j in jobs})
     heatmaps = paths.budget_heatmaps(steps, seed)
@@ -152,11 +155,12 @@ def budget_inputs(s: dict) -> list[dict]:
 
     paths, design, rules = s["paths"], BudgetTrials(**s["eval"]), s["planner"]
     inst = Instances(paths.instances)
-    rows = sum(j.count for j in design.jobs(inst.kinds, rules.tau))
     expected = design_of(inst, rules.eps, rules.max_iterations, s["seed"], design.keys(rules.tau))
     networks = sorted({k.source for k in design.keys(rules.tau) if k.source is not None})
     out = []
     for steps in s["budget"].steps:
+        jobs = design.jobs(inst.kinds, rules.tau, named=steps == max(s["budget"].steps))
+        rows = sum(j.count for j in jobs)
         for seed in s["budget"].seeds:
             file = paths.budget_trials(steps, seed)
             table = read_table(file)
@@ -187,7 +191,7 @@ def run_budget_report(cfg: DictConfig, name: str) -> dict:
     summary = analyze_budgets(inputs, settings)
     largest = [i for i in inputs if i["steps"] == inputs[-1]["steps"]]
     paper = load_paper_tables(paths.paper_tables)
-    claims = seed_claims(largest, paper, s["stats"], settings["keys"], paper["tables"])
+    claims = seed_claims(largest, paper, s["stats"])
     summary["claims"] = clean(claims)
     write_json(paths.budget_summary, summary)
     summary = read_json(paths.budget_summary)  # what every reader sees: the file's numbers

@@ -33,12 +33,16 @@ from vnrrt.studies.training_budget.pooled import paired_rows
 METRICS = ("time_to_stop", "iterations")
 
 
-def readable(paper: dict, keys: list[str], map_sets: set[str]) -> list[dict]:
-    """The quoted claims whose baseline and planner are in ``keys`` and whose column (map
-    set) is one of ``map_sets``."""
-    ok = [c["column"] in map_sets and {c["baseline"], c["planner"]} <= set(keys)
-          for c in paper["claims"]]  # fmt: skip
-    return [c for c, keep in zip(paper["claims"], ok, strict=True) if keep]
+def readable(paper: dict, runs: list[dict]) -> list[dict]:
+    """The quoted claims whose baseline and planner ran in every run of ``runs`` on the
+    claim's map set (column) at its stop rule (``paper["tables"]``)."""
+    ran = set.intersection(*(set(zip(r["trials"]["key"], r["trials"]["map_set"],
+                                      r["trials"]["stop"])) for r in runs))  # fmt: skip
+
+    def has(c: dict, key: str) -> bool:
+        return (key, c["column"], paper["tables"][c["table"]]["stop"]) in ran
+
+    return [c for c in paper["claims"] if has(c, c["baseline"]) and has(c, c["planner"])]
 
 
 def _verdict(est: float, lo: float, hi: float, claim: dict, iv: dict, level: float) -> dict:
@@ -70,21 +74,20 @@ def _per_seed(runs: list[dict], claim: dict, stop: str, iv: dict, n_boot: int, l
     return out
 
 
-def seed_claims(runs: list[dict], paper: dict, st, keys: list[str], tables: dict) -> dict:
+def seed_claims(runs: list[dict], paper: dict, st) -> dict:
     """The claims over the seeds' runs ``runs`` (each ``seed`` and ``trials``, one budget;
-    module doc). ``st``: the ``stats`` section; ``keys``: the budget trials' configurations;
-    ``tables``: ``paper["tables"]`` (each claim's stop rule). Returns ``level``,
+    module doc). ``st``: the ``stats`` section; ``paper``: the paper's tables (its claims,
+    each table's stop rule, the comparable map sets). Returns ``level``,
     ``corrected_level``, ``bootstrap``, ``seeds`` and one row per claim: the claim's
     fields, ``comparable`` (its map set is the paper's comparable one), ``paper`` (its
     interval), ``pooled`` ``{metric: reading}`` and ``per_seed``."""
-    map_sets = set().union(*(set(r["trials"]["map_set"]) for r in runs))
-    claims = readable(paper, keys, map_sets)
+    claims = readable(paper, runs)
     comparable = set(paper.get("comparable_columns", []))
     strict = bonferroni_level(st.level, max(len(claims), 1))
     n_boot = claim_boot(st.bootstrap, st.tail_draws, strict)
     rows = []
     for claim in claims:
-        stop = tables[claim["table"]]["stop"]
+        stop = paper["tables"][claim["table"]]["stop"]
         iv = claim_interval(paper, claim, strict).as_dict()
         pooled = {}
         for metric in METRICS:

@@ -1,9 +1,9 @@
 """What the budget curve's trials run, per budget (stage ``budget_trials@<steps>-<seed>``):
 RRT* and every learned planner of ``eval.planners`` sampling its ``eval.sources`` network,
-M-VNRRT* at the claims' threshold ``planner.tau`` only, not informed, on every instance of
-the instances file: the random instances (the comparable map set, which the curve reads) and
-the named maps (the paper's named-map claims, read over the training seeds at the largest
-budget), every stop rule of the protocol with its trial counts (``eval.named_initial``,
+M-VNRRT* at the claims' threshold ``planner.tau`` only, not informed, on the random instances
+of the instances file (the comparable map set, which the curve reads) and, at the largest
+budget only, the named maps (the paper's named-map claims, read over the training seeds
+there), every stop rule of the protocol with its trial counts (``eval.named_initial``,
 ``eval.named_optimal``, ``eval.random_initial``, ``eval.random_optimal``,
 ``eval.any_angle``), its obstacle rule (``eval.zero_obstacles``) and its paired seeds, so
 that a budget's configurations are compared on the same trials, and the budgets and
@@ -47,21 +47,27 @@ class BudgetTrials:
                             cap_factor=self.cap_factor)  # fmt: skip
         return configurations(ev, [tau], tau)
 
-    def counts(self) -> dict[tuple[str, str], int]:
-        """Trials per instance for each (instance kind, stop rule), as the protocol's."""
-        ev = EvalConfig(named_initial=self.named_initial, named_optimal=self.named_optimal,
+    def counts(self, *, named: bool) -> dict[tuple[str, str], int]:
+        """Trials per instance for each (instance kind, stop rule), as the protocol's; none on
+        the named maps unless ``named`` (the largest budget)."""
+        ev = EvalConfig(named_initial=self.named_initial if named else 0,
+                        named_optimal=self.named_optimal if named else 0,
                         random_initial=self.random_initial, random_optimal=self.random_optimal,
                         any_angle=self.any_angle)  # fmt: skip
         return trial_counts(ev)
 
-    def jobs(self, kinds: list[str], tau: float) -> list[TrialJob]:
+    def jobs(self, kinds: list[str], tau: float, *, named: bool) -> list[TrialJob]:
         """Every job in canonical order; ``kinds[i]``: instance ``i``'s kind (``named`` or
-        ``random``) in the instances file."""
-        return trial_jobs(kinds, self.keys(tau), self.counts())
+        ``random``) in the instances file; the named maps' only when ``named``."""
+        return trial_jobs(kinds, self.keys(tau), self.counts(named=named))
 
     def stops(self) -> list[str]:
-        """The stop rules that run, in the protocol's order."""
-        return list(dict.fromkeys(stop for (kind, stop), n in self.counts().items() if n))
+        """The stop rules the curve reads (those run on the random maps), in the protocol's
+        order."""
+        counts = self.counts(named=False)
+        return list(
+            dict.fromkeys(stop for (kind, stop), n in counts.items() if n and kind == "random")
+        )
 
     def ratio_keys(self, tau: float) -> list[ConfigKey]:
         """The planners compared with NRRT* (:data:`CONTROL`): VNRRT* and M-VNRRT*."""

@@ -46,7 +46,8 @@ def header(summary: dict) -> list[str]:
         f"budget of {steps} optimizer steps ({images} training images seen) at every seed, "
         "each with a one-cycle learning-rate schedule of its own sized to its steps "
         f"(`conf/budget`), then evaluated on the same {summary['instances']} random test "
-        f"instances ({summary['clusters']} base maps) with the protocol's paired seeds.",
+        f"instances ({summary['clusters']} base maps) with the protocol's paired seeds; at "
+        "the largest budget also on the named maps, for the paper's claims over the seeds.",
         "",
         f"- Speed-ups are paired and {pooled} ({level_name(s['level'])}, {s['bootstrap']} "
         "resamples). Failures (budget hits) enter at their stop value. A ratio X / NRRT* is "
