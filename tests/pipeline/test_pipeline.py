@@ -838,15 +838,15 @@ def test_the_budget_stages_reproduce_the_training_of_their_steps(workdir):
     _back_to_the_commit(workdir)
     client = MlflowClient(f"sqlite:///{workdir / 'mlflow.db'}")
     registered = len(client.search_model_versions("name='vnrrt-vertexnet'"))
-    (workdir / "params.yaml").write_text(
-        dump(compose([*SMOKE, seed_override(workdir), *ONE_BUDGET]))
-    )
+    cfg = compose([*SMOKE, seed_override(workdir), *ONE_BUDGET])
+    (workdir / "params.yaml").write_text(dump(cfg))
+    item = f"3-{cfg.train.seed}"  # the one budget of 3 steps at the pipeline's training seed
     out = run(["dvc", "repro"], workdir)
     ran = {line.split("'")[1].split("@")[0] for line in out.splitlines() if "Running" in line}
     assert ran == {"validate", *BUDGET_STAGES}, out
     assert stages_writing_their_outputs(workdir) >= BUDGET_STAGES
 
-    metrics, budget = workdir / "reports/metrics", workdir / "data/smoke/budget/3-1"
+    metrics, budget = workdir / "reports/metrics", workdir / f"data/smoke/budget/{item}"
     predict = json.loads((metrics / "predict.json").read_text())["networks"]
     again = json.loads((budget / "predict.json").read_text())["networks"]
     sha = {}
@@ -865,7 +865,7 @@ def test_the_budget_stages_reproduce_the_training_of_their_steps(workdir):
     exp = client.get_experiment_by_name("vnrrt-smoke").experiment_id
     runs = client.search_runs([exp], filter_string="tags.budget_steps = '3'")
     stages = sorted(r.data.tags["dvc_stage"] for r in runs)
-    assert stages == ["budget_train@nrrtnet-3-1", "budget_train@vertexnet-3-1"]  # train.seed 1
+    assert stages == [f"budget_train@nrrtnet-{item}", f"budget_train@vertexnet-{item}"]
     for r in runs:
         name = f"{r.data.tags['kind']} smoke budget 3"  # then the overrides of the defaults
         assert r.data.params["budget.steps"] == "3" and r.info.run_name.startswith(name)
