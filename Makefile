@@ -53,9 +53,10 @@ CPU_REPORTS := reports/cpu
 # training seeds 0-3 (the claims read over the four network pairs at the largest budget) and
 # the benchmark-maps study. Wall time on a 2-core AVX-512 machine with bf16: ~40 min for the
 # data and both trainings, ~35 min the trials, oracle selection and regime grid, ~3 min the
-# reports; ~2.5 h the budget curve (32 trainings); the per-trial tables of both go to
+# reports; ~3.7 h the budget curve (32 trainings: a network pair ~30, 15, 8 and 4 min at
+# 4,800, 2,400, 1,200 and 600 steps); the per-trial tables of both go to
 # reports/cpu/results/.
-repro-cpu: $(STAMP)  ## the CPU study scale (about 4 h on 2 cores): the pipeline at seed 0 (reports first), the training-budget curve at 4 training seeds and the benchmark-maps study; reports copied to reports/cpu/, the per-trial tables behind them to reports/cpu/results/
+repro-cpu: $(STAMP)  ## the CPU study scale (about 5.5 h on 2 cores): the pipeline at seed 0 (reports first), the training-budget curve at 4 training seeds and the benchmark-maps study; reports copied to reports/cpu/, the per-trial tables behind them to reports/cpu/results/
 	$(BIN)/dvc exp run -S scale=cpu ideas report
 	rm -rf $(CPU_REPORTS) && mkdir -p $(CPU_REPORTS)
 	cp -r reports/paper_comparison.md reports/sampling_ideas.md reports/metrics reports/figures $(CPU_REPORTS)/
