@@ -106,11 +106,11 @@ def run_budget_trials(cfg: DictConfig, steps: int, seed: int) -> int:
     from vnrrt.data.instances import Instances, load
     from vnrrt.evaluation.table import with_network_seeds, write_table
     from vnrrt.evaluation.trials import TrialSettings, run_jobs
-    from vnrrt.studies.training_budget.design import BudgetTrials
+    from vnrrt.studies.training_budget.design import BudgetTrials, runs_named_maps
 
     s = trials_settings(cfg)
     paths, planner, design = s["paths"], s["planner"], BudgetTrials(**s["eval"])
-    named = int(steps) == max(s["budget"]["steps"])  # the largest budget runs the named maps
+    named = runs_named_maps(steps, s["budget"]["steps"])
     jobs = design.jobs(Instances(paths.instances).kinds, planner.tau, named=named)
     networks = sorted({j.key.source for j in jobs if j.key.source is not None})
     indices = sorted({j.instance for j in jobs})
@@ -151,7 +151,7 @@ def budget_inputs(s: dict) -> list[dict]:
     from vnrrt.evaluation.invariants import design_of
     from vnrrt.evaluation.table import TableError, read_table
     from vnrrt.infra.io import read_json
-    from vnrrt.studies.training_budget.design import BudgetTrials
+    from vnrrt.studies.training_budget.design import BudgetTrials, runs_named_maps
 
     paths, design, rules = s["paths"], BudgetTrials(**s["eval"]), s["planner"]
     inst = Instances(paths.instances)
@@ -159,7 +159,7 @@ def budget_inputs(s: dict) -> list[dict]:
     networks = sorted({k.source for k in design.keys(rules.tau) if k.source is not None})
     out = []
     for steps in s["budget"].steps:
-        jobs = design.jobs(inst.kinds, rules.tau, named=steps == max(s["budget"].steps))
+        jobs = design.jobs(inst.kinds, rules.tau, named=runs_named_maps(steps, s["budget"].steps))
         rows = sum(j.count for j in jobs)
         for seed in s["budget"].seeds:
             file = paths.budget_trials(steps, seed)

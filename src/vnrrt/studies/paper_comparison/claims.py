@@ -61,7 +61,13 @@ def verdict_text(row: dict) -> str:
     text, it = row["verdict"], row.get("iterations")
     if row.get("time_to_stop") and it and it["verdict"] != text:
         text = f"{text}; on iterations: {it['verdict']}"
-    return text if row["comparable"] else f"different map: not comparable ({text})"
+    return on_its_map(text, row["comparable"])
+
+
+def on_its_map(verdict: str, comparable: bool) -> str:
+    """``verdict`` as said of a claim on the paper's comparable map set, or wrapped as
+    ``different map: not comparable (...)`` off it."""
+    return verdict if comparable else f"different map: not comparable ({verdict})"
 
 
 def mask_shares(table: pd.DataFrame) -> dict:

@@ -4,7 +4,7 @@
 from __future__ import annotations
 
 from vnrrt.names import level_name
-from vnrrt.studies.paper_comparison.claims import improvement
+from vnrrt.studies.paper_comparison.claims import improvement, on_its_map
 
 
 def _seed_cell(seed: str, cell: dict) -> str:
@@ -39,9 +39,7 @@ def seed_claims_section(summary: dict) -> list[str]:
     for row in c["rows"]:
         pooled = row["pooled"]
         per = "; ".join(_seed_cell(k, v) for k, v in row["per_seed"].items())
-        verdict = pooled["time_to_stop"]["verdict"]
-        if not row.get("comparable", True):
-            verdict = f"different map: not comparable ({verdict})"
+        verdict = on_its_map(pooled["time_to_stop"]["verdict"], row["comparable"])
         cells = [row["text"], f"{row['quoted']:+.2%}", improvement(pooled["time_to_stop"]),
                  verdict, improvement(pooled["iterations"]), per,
                  f"{row['testable_seeds']} of {len(row['per_seed'])}"]  # fmt: skip

@@ -22,6 +22,12 @@ BASELINE = ConfigKey("rrt_star")
 CONTROL = "nrrt_star"  # the planner the VNRRT* ratio is taken against
 
 
+def runs_named_maps(steps: int, budgets: list[int]) -> bool:
+    """Whether the budget of ``steps`` (one of ``budgets``, ``budget.steps``) also runs the
+    named maps: only the largest does (its trials read the paper's claims over the seeds)."""
+    return int(steps) == max(int(b) for b in budgets)
+
+
 @dataclass(frozen=True)
 class BudgetTrials:
     """The ``eval`` keys the budget trials read (module doc)."""
@@ -64,10 +70,7 @@ class BudgetTrials:
     def stops(self) -> list[str]:
         """The stop rules the curve reads (those run on the random maps), in the protocol's
         order."""
-        counts = self.counts(named=False)
-        return list(
-            dict.fromkeys(stop for (kind, stop), n in counts.items() if n and kind == "random")
-        )
+        return list(dict.fromkeys(stop for (_, stop), n in self.counts(named=False).items() if n))
 
     def ratio_keys(self, tau: float) -> list[ConfigKey]:
         """The planners compared with NRRT* (:data:`CONTROL`): VNRRT* and M-VNRRT*."""
